@@ -1,0 +1,82 @@
+//! A pinhole camera: primary rays that all start at one focal point.
+//!
+//! The image plane is given by the centre of pixel (0, 0) minus half a pixel (`corner`) and
+//! the vectors `du`, `dv` that step one pixel right and down. Pixel `(x, y)`'s ray starts at
+//! the focal point `eye` and has the unit direction of `corner + (x + ½)·du + (y + ½)·dv − eye`.
+//! Every ray of the camera shares its origin, which is what the focal-point caches
+//! ([`FocalSpheres`](crate::sphere::FocalSphere), [`FocalPlane`](crate::plane::FocalPlane))
+//! exploit.
+
+use glam::Vec3;
+
+use crate::lane::Lane;
+use crate::ray::RayPacket;
+use crate::vec3::V3;
+
+/// A pinhole camera with a focal point and an image plane.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Pinhole {
+    /// The focal point: origin of every primary ray.
+    pub eye: Vec3,
+    /// Corner of the image plane (the outer corner of pixel (0, 0)).
+    pub corner: Vec3,
+    /// One pixel to the right.
+    pub du: Vec3,
+    /// One pixel down.
+    pub dv: Vec3,
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+}
+
+impl Pinhole {
+    /// A camera at `eye` looking at `target`, with `up` roughly up, a vertical field of view
+    /// of `vfov_degrees`, and an image of `width × height` pixels (square pixels).
+    #[must_use]
+    pub fn look_at(
+        eye: Vec3,
+        target: Vec3,
+        up: Vec3,
+        vfov_degrees: f32,
+        width: u32,
+        height: u32,
+    ) -> Self {
+        let forward = (target - eye).normalize_or_zero();
+        let right = forward.cross(up).normalize_or_zero();
+        let down = forward.cross(right);
+        let half_h = libm::tanf(vfov_degrees.to_radians() * 0.5);
+        let pixel = 2.0 * half_h / height.max(1) as f32;
+        let du = right * pixel;
+        let dv = down * pixel;
+        let corner = eye + forward - du * (width as f32 * 0.5) - dv * (height as f32 * 0.5);
+        Pinhole {
+            eye,
+            corner,
+            du,
+            dv,
+            width,
+            height,
+        }
+    }
+
+    /// The rays of pixels `(x, y) … (x + L::LANES − 1, y)` of one image row, unit directions,
+    /// interval `(0, +inf)`. Lanes past the right edge never hit.
+    #[must_use]
+    pub fn row_packet<L: Lane>(&self, x: u32, y: u32) -> RayPacket<L> {
+        let px = L::from_f32_fn(|i| (x + i as u32) as f32 + 0.5);
+        let py = L::from_f32((y as f32) + 0.5);
+        let corner = V3::<L>::splat(self.corner);
+        let target = corner + V3::splat(self.du).scale(px) + V3::splat(self.dv).scale(py);
+        let d = target - V3::splat(self.eye);
+        let dir = d.div_by(d.length_squared().sqrt());
+        let inside = L::from_f32_fn(|i| {
+            if x + (i as u32) < self.width && y < self.height {
+                f32::INFINITY
+            } else {
+                0.0
+            }
+        });
+        RayPacket::new(V3::splat(self.eye), dir, L::from_f32(0.0), inside)
+    }
+}

@@ -1,0 +1,242 @@
+//! Hit records and the loops shared by every primitive: closest hit, any hit.
+//!
+//! A kernel tests ray lanes against primitive lanes and reports a [`LaneHit`]: the parameter
+//! `t`, two surface parameters `u`, `v` (barycentrics for triangles, zero otherwise) and the
+//! lanes that hit. The loops here run a kernel over a slice of primitives:
+//!
+//! * **N rays × 1 primitive** ([`closest`], [`any`]): the primitive is splatted into every lane
+//!   and the rays' `t_max` shrinks as hits are found, so later primitives must be closer;
+//! * **1 ray × N primitives** ([`closest_soa`], [`any_soa`]): primitives sit in lanes (structure
+//!   of arrays), the ray is splatted, and the lanes are reduced at the end.
+//!
+//! Both shapes return the same hit, bit for bit: each test computes `t` the same way whatever
+//! the lane, and ties go to the lowest primitive index.
+//!
+//! Misses are canonical: `t = +inf`, `u = v = 0`, index `u32::MAX`. No record ever holds a NaN.
+
+use crate::lane::{Lane, Mask, Scalar, select_indices};
+use crate::ray::{Ray, RayPacket};
+
+/// One lane-wise test result (see the [module docs](self)).
+#[derive(Clone, Copy, Debug)]
+pub struct LaneHit<L: Lane> {
+    /// Ray parameter of the hit; `+inf` where `mask` is clear.
+    pub t: L,
+    /// First surface parameter (barycentric weight of vertex B for triangles).
+    pub u: L,
+    /// Second surface parameter (barycentric weight of vertex C for triangles).
+    pub v: L,
+    /// Lanes that hit inside the ray interval.
+    pub mask: L::Mask,
+}
+
+impl<L: Lane> LaneHit<L> {
+    /// No lane hits.
+    #[inline(always)]
+    #[must_use]
+    pub fn miss() -> Self {
+        let zero = L::from_f32(0.0);
+        LaneHit {
+            t: L::from_f32(f32::INFINITY),
+            u: zero,
+            v: zero,
+            mask: Mask::splat(false),
+        }
+    }
+
+    /// Canonicalises: lanes outside `mask` get `t = +inf`, `u = v = 0`.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(t: L, u: L, v: L, mask: L::Mask) -> Self {
+        let zero = L::from_f32(0.0);
+        LaneHit {
+            t: L::select(mask, t, L::from_f32(f32::INFINITY)),
+            u: L::select(mask, u, zero),
+            v: L::select(mask, v, zero),
+            mask,
+        }
+    }
+}
+
+/// The closest hit per lane over a set of primitives, with the primitive's index.
+#[derive(Clone, Copy, Debug)]
+pub struct Hit<L: Lane> {
+    /// Ray parameter; `+inf` where `mask` is clear.
+    pub t: L,
+    /// First surface parameter (barycentric weight of B for triangles).
+    pub u: L,
+    /// Second surface parameter (barycentric weight of C for triangles).
+    pub v: L,
+    /// Index of the primitive hit in each lane (`u32::MAX` where `mask` is clear).
+    pub index: L::Indices,
+    /// Lanes that hit.
+    pub mask: L::Mask,
+}
+
+/// One hit of one ray, as the scalar API reports it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HitRecord {
+    /// Ray parameter: the point is `origin + t·dir`.
+    pub t: f32,
+    /// First surface parameter (barycentric weight of B for triangles; 0 otherwise).
+    pub u: f32,
+    /// Second surface parameter (barycentric weight of C for triangles; 0 otherwise).
+    pub v: f32,
+    /// Index of the primitive in the slice that was searched.
+    pub index: u32,
+}
+
+impl<L: Lane> Hit<L> {
+    /// No hit in any lane.
+    #[inline]
+    #[must_use]
+    pub fn none() -> Self {
+        let m = LaneHit::<L>::miss();
+        Hit {
+            t: m.t,
+            u: m.u,
+            v: m.v,
+            index: L::indices(u32::MAX),
+            mask: m.mask,
+        }
+    }
+
+    /// Lane `i` as a scalar record, or `None` when it missed.
+    #[inline]
+    #[must_use]
+    pub fn lane(&self, i: usize) -> Option<HitRecord>
+    where
+        L: Lane<Scalar = f32>,
+    {
+        self.mask.test(i).then(|| HitRecord {
+            t: self.t.lane(i),
+            u: self.u.lane(i),
+            v: self.v.lane(i),
+            index: self.index.as_ref()[i],
+        })
+    }
+
+    /// Takes the hits of `h` (which must be closer where set) for primitive `index`.
+    #[inline(always)]
+    pub fn update(&mut self, h: &LaneHit<L>, index: u32) {
+        if h.mask.any() {
+            self.t = L::select(h.mask, h.t, self.t);
+            self.u = L::select(h.mask, h.u, self.u);
+            self.v = L::select(h.mask, h.v, self.v);
+            self.mask = self.mask | h.mask;
+            select_indices::<L>(h.mask, index, &mut self.index);
+        }
+    }
+}
+
+impl Hit<f32> {
+    /// The record, or `None` for a miss.
+    #[inline]
+    #[must_use]
+    pub fn get(&self) -> Option<HitRecord> {
+        self.lane(0)
+    }
+}
+
+/// Closest hit of ray lanes over primitives tested one at a time (N rays × 1 primitive).
+///
+/// `test` sees the rays with `t_max` already shrunk to the closest hit so far, so it reports
+/// only closer hits.
+#[inline]
+pub fn closest<L: Lane, P>(
+    rays: &RayPacket<L>,
+    prims: impl IntoIterator<Item = P>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
+) -> Hit<L> {
+    let mut r = *rays;
+    let mut best = Hit::none();
+    for (i, p) in prims.into_iter().enumerate() {
+        let h = test(&r, p);
+        if h.mask.any() {
+            best.update(&h, i as u32);
+            r = r.shrink(h.mask, h.t);
+        }
+    }
+    best
+}
+
+/// True in lanes where some primitive is hit (occlusion); stops when every valid lane is hit.
+#[inline]
+pub fn any<L: Lane, P>(
+    rays: &RayPacket<L>,
+    prims: impl IntoIterator<Item = P>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
+) -> L::Mask {
+    let valid = rays.valid();
+    let mut hit = L::Mask::splat(false);
+    for p in prims {
+        hit = hit | test(rays, p).mask;
+        if valid.and_not(hit).none() {
+            break;
+        }
+    }
+    hit & valid
+}
+
+/// Closest hit of one ray over primitives stored `L::LANES` to a chunk (1 ray × N primitives).
+///
+/// `test` gets the ray splatted into lanes (with per-lane shrinking `t_max`) and the chunk
+/// index; primitive `j` of chunk `c` has index `c·L::LANES + j`. Lanes past `count` must miss
+/// (padding), which the primitive packets guarantee.
+#[inline]
+pub fn closest_soa<L: Lane, P>(
+    ray: &Ray,
+    chunks: impl IntoIterator<Item = P>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
+) -> Option<HitRecord>
+where
+    L::Scalar: Scalar,
+{
+    let mut r = RayPacket::<L>::splat(ray);
+    let mut best = Hit::<L>::none();
+    for (c, p) in chunks.into_iter().enumerate() {
+        let h = test(&r, p);
+        if h.mask.any() {
+            let mut bits = h.mask.bits();
+            while bits != 0 {
+                let j = bits.trailing_zeros() as usize;
+                best.index.as_mut()[j] = (c * L::LANES + j) as u32;
+                bits &= bits - 1;
+            }
+            best.t = L::select(h.mask, h.t, best.t);
+            best.u = L::select(h.mask, h.u, best.u);
+            best.v = L::select(h.mask, h.v, best.v);
+            best.mask = best.mask | h.mask;
+            r = r.shrink(h.mask, h.t);
+        }
+    }
+    // Reduce across lanes: smallest t, ties to the lowest index.
+    let mut out: Option<HitRecord> = None;
+    for j in 0..L::LANES {
+        if !best.mask.test(j) {
+            continue;
+        }
+        let rec = HitRecord {
+            t: best.t.lane(j).to_f64() as f32,
+            u: best.u.lane(j).to_f64() as f32,
+            v: best.v.lane(j).to_f64() as f32,
+            index: best.index.as_ref()[j],
+        };
+        out = match out {
+            Some(o) if o.t < rec.t || (o.t == rec.t && o.index < rec.index) => Some(o),
+            _ => Some(rec),
+        };
+    }
+    out
+}
+
+/// True when one ray hits some primitive stored in lanes (1 ray × N primitives).
+#[inline]
+pub fn any_soa<L: Lane, P>(
+    ray: &Ray,
+    chunks: impl IntoIterator<Item = P>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
+) -> bool {
+    let r = RayPacket::<L>::splat(ray);
+    chunks.into_iter().any(|p| test(&r, p).mask.any())
+}

@@ -1,0 +1,506 @@
+//! Lanes: the one abstraction every kernel is written over.
+//!
+//! A kernel in this crate is a generic function over [`Lane`]. The same body then runs as
+//!
+//! * the scalar reference (`f32`), a higher-precision scalar (`f64`),
+//! * packets of 4, 8 or 16 rays or primitives (`wide::f32x4`, `f32x8`, `f32x16`),
+//! * the op-counting type [`Counted`](crate::opcount::Counted), which counts every multiply,
+//!   addition, division, square root and compare the body performs.
+//!
+//! Only correctly rounded IEEE-754 operations (`+ - * /`, `sqrt`, compares) are offered, and a
+//! generic body fixes their order, so every lane of every width returns the same bits as the
+//! scalar path, on every target. No fused multiply-add is used.
+//!
+//! Branches become masks: a comparison yields a [`Mask`], [`Lane::select`] picks per lane, and a
+//! kernel returns early when [`Mask::any`] says no lane is left (for `f32` the mask is `bool`,
+//! so the scalar path simply branches).
+
+use core::fmt::Debug;
+use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
+
+use wide::{f32x4, f32x8, f32x16};
+
+/// The element type of a lane: `f32` or `f64`.
+pub trait Scalar: Copy + Debug + PartialOrd + Default + 'static {
+    /// Widens to `f64` (exact for both `f32` and `f64`).
+    fn to_f64(self) -> f64;
+    /// Rounds an `f64` to this type (to nearest, ties to even).
+    fn from_f64(x: f64) -> Self;
+    /// Converts an `f32` exactly.
+    fn from_f32(x: f32) -> Self;
+}
+
+impl Scalar for f32 {
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self as f64
+    }
+    #[inline(always)]
+    fn from_f64(x: f64) -> Self {
+        x as f32
+    }
+    #[inline(always)]
+    fn from_f32(x: f32) -> Self {
+        x
+    }
+}
+
+impl Scalar for f64 {
+    #[inline(always)]
+    fn to_f64(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn from_f64(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn from_f32(x: f32) -> Self {
+        x as f64
+    }
+}
+
+/// A per-lane boolean: `bool` for scalar lanes, an all-ones/all-zeros SIMD vector for packets.
+pub trait Mask:
+    Copy + Debug + BitAnd<Output = Self> + BitOr<Output = Self> + Not<Output = Self>
+{
+    /// The same value in every lane.
+    fn splat(b: bool) -> Self;
+    /// True when some lane is set.
+    fn any(self) -> bool;
+    /// True when every lane is set.
+    fn all(self) -> bool;
+    /// Bit `i` is lane `i`.
+    fn bits(self) -> u32;
+    /// Returns `self` with lane `i` set to `b`.
+    fn with_lane(self, i: usize, b: bool) -> Self;
+    /// True when no lane is set.
+    #[inline(always)]
+    fn none(self) -> bool {
+        !self.any()
+    }
+    /// Lane `i`.
+    #[inline(always)]
+    fn test(self, i: usize) -> bool {
+        (self.bits() >> i) & 1 != 0
+    }
+    /// `self & !other`.
+    #[inline(always)]
+    fn and_not(self, other: Self) -> Self {
+        self & !other
+    }
+}
+
+impl Mask for bool {
+    #[inline(always)]
+    fn splat(b: bool) -> Self {
+        b
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn all(self) -> bool {
+        self
+    }
+    #[inline(always)]
+    fn bits(self) -> u32 {
+        self as u32
+    }
+    #[inline(always)]
+    fn with_lane(self, _i: usize, b: bool) -> Self {
+        b
+    }
+}
+
+/// A lane of floating-point values: the type every kernel is generic over.
+///
+/// Arithmetic (`+ - * /`, [`sqrt`](Lane::sqrt)) and comparisons are the operations a kernel may
+/// count on; they are all correctly rounded. [`select`](Lane::select), [`abs`](Lane::abs),
+/// negation and mask operations are sign or bit manipulations and are not counted as
+/// floating-point work.
+pub trait Lane:
+    Copy
+    + Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+{
+    /// The element type.
+    type Scalar: Scalar;
+    /// The per-lane boolean.
+    type Mask: Mask;
+    /// A single `f64` lane used for rare higher-precision fallbacks of one lane
+    /// (`f64` itself, or `Counted<f64>` when counting).
+    type Precise: Lane<Scalar = f64>;
+    /// One `u32` per lane, for primitive indices in hit records.
+    type Indices: Copy + Debug + PartialEq + AsRef<[u32]> + AsMut<[u32]>;
+    /// Number of lanes.
+    const LANES: usize;
+
+    /// The same value in every lane.
+    fn splat(x: Self::Scalar) -> Self;
+    /// An `f32` constant in every lane (exact).
+    #[inline(always)]
+    fn from_f32(x: f32) -> Self {
+        Self::splat(Self::Scalar::from_f32(x))
+    }
+    /// Correctly rounded square root.
+    fn sqrt(self) -> Self;
+    /// `self < rhs` per lane (false when either is NaN).
+    fn lt(self, rhs: Self) -> Self::Mask;
+    /// `self <= rhs` per lane (false when either is NaN).
+    fn le(self, rhs: Self) -> Self::Mask;
+    /// `self > rhs` per lane (false when either is NaN).
+    fn gt(self, rhs: Self) -> Self::Mask;
+    /// `self >= rhs` per lane (false when either is NaN).
+    fn ge(self, rhs: Self) -> Self::Mask;
+    /// `if mask { a } else { b }` per lane.
+    fn select(mask: Self::Mask, a: Self, b: Self) -> Self;
+    /// Absolute value (clears the sign bit; not counted).
+    fn abs(self) -> Self;
+    /// True where the value is neither NaN nor infinite (a bit test; not counted).
+    fn is_finite(self) -> Self::Mask;
+    /// Lane `i`.
+    fn lane(self, i: usize) -> Self::Scalar;
+    /// Builds a lane value from its elements.
+    fn from_fn(f: impl FnMut(usize) -> Self::Scalar) -> Self;
+    /// Every index set to `v`.
+    fn indices(v: u32) -> Self::Indices;
+    /// Lane `i` as a single higher-precision lane (exact widening).
+    fn precise_lane(self, i: usize) -> Self::Precise;
+
+    /// Builds a lane value from `f32` elements (exact).
+    #[inline(always)]
+    fn from_f32_fn(mut f: impl FnMut(usize) -> f32) -> Self {
+        Self::from_fn(|i| Self::Scalar::from_f32(f(i)))
+    }
+    /// Returns `self` with lane `i` replaced by `v`.
+    #[inline(always)]
+    fn with_lane(self, i: usize, v: Self::Scalar) -> Self {
+        Self::from_fn(|j| if j == i { v } else { self.lane(j) })
+    }
+}
+
+/// Correctly rounded `f32` square root for the scalar lane.
+///
+/// x86-64 (`sqrtss`) and AArch64 (`fsqrt`) get the instruction through `libm`; on Cortex-M
+/// with a hard-float FPU the `vsqrt.f32` instruction is used directly (both are IEEE-754
+/// correctly rounded, so all targets agree to the bit).
+#[inline(always)]
+pub fn sqrt_f32(x: f32) -> f32 {
+    #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+    {
+        arm_vsqrt(x)
+    }
+    #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+    {
+        libm::sqrtf(x)
+    }
+}
+
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[inline(always)]
+fn arm_vsqrt(x: f32) -> f32 {
+    let out: u32;
+    // SAFETY: pure register arithmetic on the FPU (present on every eabihf target); s0's old
+    // value is saved in a core register and restored, so no FPU register is clobbered.
+    unsafe {
+        core::arch::asm!(
+            "vmov {save}, s0",
+            "vmov s0, {x}",
+            "vsqrt.f32 s0, s0",
+            "vmov {out}, s0",
+            "vmov s0, {save}",
+            x = in(reg) x.to_bits(),
+            out = lateout(reg) out,
+            save = out(reg) _,
+            options(pure, nomem, nostack),
+        );
+    }
+    f32::from_bits(out)
+}
+
+impl Lane for f32 {
+    type Scalar = f32;
+    type Mask = bool;
+    type Precise = f64;
+    type Indices = [u32; 1];
+    const LANES: usize = 1;
+
+    #[inline(always)]
+    fn splat(x: f32) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        sqrt_f32(self)
+    }
+    #[inline(always)]
+    fn lt(self, rhs: Self) -> bool {
+        self < rhs
+    }
+    #[inline(always)]
+    fn le(self, rhs: Self) -> bool {
+        self <= rhs
+    }
+    #[inline(always)]
+    fn gt(self, rhs: Self) -> bool {
+        self > rhs
+    }
+    #[inline(always)]
+    fn ge(self, rhs: Self) -> bool {
+        self >= rhs
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask { a } else { b }
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f32::from_bits(self.to_bits() & 0x7fff_ffff)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        self.to_bits() & 0x7f80_0000 != 0x7f80_0000
+    }
+    #[inline(always)]
+    fn lane(self, _i: usize) -> f32 {
+        self
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> f32) -> Self {
+        f(0)
+    }
+    #[inline(always)]
+    fn indices(v: u32) -> [u32; 1] {
+        [v]
+    }
+    #[inline(always)]
+    fn precise_lane(self, _i: usize) -> f64 {
+        self as f64
+    }
+}
+
+impl Lane for f64 {
+    type Scalar = f64;
+    type Mask = bool;
+    type Precise = f64;
+    type Indices = [u32; 1];
+    const LANES: usize = 1;
+
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        libm::sqrt(self)
+    }
+    #[inline(always)]
+    fn lt(self, rhs: Self) -> bool {
+        self < rhs
+    }
+    #[inline(always)]
+    fn le(self, rhs: Self) -> bool {
+        self <= rhs
+    }
+    #[inline(always)]
+    fn gt(self, rhs: Self) -> bool {
+        self > rhs
+    }
+    #[inline(always)]
+    fn ge(self, rhs: Self) -> bool {
+        self >= rhs
+    }
+    #[inline(always)]
+    fn select(mask: bool, a: Self, b: Self) -> Self {
+        if mask { a } else { b }
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        f64::from_bits(self.to_bits() & 0x7fff_ffff_ffff_ffff)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> bool {
+        self.to_bits() & 0x7ff0_0000_0000_0000 != 0x7ff0_0000_0000_0000
+    }
+    #[inline(always)]
+    fn lane(self, _i: usize) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn from_fn(mut f: impl FnMut(usize) -> f64) -> Self {
+        f(0)
+    }
+    #[inline(always)]
+    fn indices(v: u32) -> [u32; 1] {
+        [v]
+    }
+    #[inline(always)]
+    fn precise_lane(self, _i: usize) -> f64 {
+        self
+    }
+}
+
+/// Implements [`Mask`] and [`Lane`] for a `wide` f32 vector type: one macro, so the widths
+/// cannot drift apart.
+macro_rules! wide_lane {
+    ($t:ident, $n:literal) => {
+        impl Mask for $t {
+            #[inline(always)]
+            fn splat(b: bool) -> Self {
+                $t::splat(f32::from_bits(if b { u32::MAX } else { 0 }))
+            }
+            #[inline(always)]
+            fn any(self) -> bool {
+                $t::any(self)
+            }
+            #[inline(always)]
+            fn all(self) -> bool {
+                $t::all(self)
+            }
+            #[inline(always)]
+            fn bits(self) -> u32 {
+                self.to_bitmask()
+            }
+            #[inline(always)]
+            fn with_lane(self, i: usize, b: bool) -> Self {
+                let mut a = self.to_array();
+                a[i] = f32::from_bits(if b { u32::MAX } else { 0 });
+                $t::new(a)
+            }
+        }
+
+        impl Lane for $t {
+            type Scalar = f32;
+            type Mask = $t;
+            type Precise = f64;
+            type Indices = [u32; $n];
+            const LANES: usize = $n;
+
+            #[inline(always)]
+            fn splat(x: f32) -> Self {
+                $t::splat(x)
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+                {
+                    // wide's portable fallback is a software f64 root; use the FPU per lane.
+                    let a = self.to_array();
+                    $t::new(core::array::from_fn(|i| sqrt_f32(a[i])))
+                }
+                #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+                {
+                    $t::sqrt(self)
+                }
+            }
+            #[inline(always)]
+            fn lt(self, rhs: Self) -> Self {
+                self.simd_lt(rhs)
+            }
+            #[inline(always)]
+            fn le(self, rhs: Self) -> Self {
+                self.simd_le(rhs)
+            }
+            #[inline(always)]
+            fn gt(self, rhs: Self) -> Self {
+                self.simd_gt(rhs)
+            }
+            #[inline(always)]
+            fn ge(self, rhs: Self) -> Self {
+                self.simd_ge(rhs)
+            }
+            #[inline(always)]
+            fn select(mask: Self, a: Self, b: Self) -> Self {
+                mask.select(a, b)
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                $t::abs(self)
+            }
+            #[inline(always)]
+            fn is_finite(self) -> Self {
+                $t::is_finite(self)
+            }
+            #[inline(always)]
+            fn lane(self, i: usize) -> f32 {
+                self.as_array()[i]
+            }
+            #[inline(always)]
+            fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
+                $t::new(core::array::from_fn(f))
+            }
+            #[inline(always)]
+            fn indices(v: u32) -> [u32; $n] {
+                [v; $n]
+            }
+            #[inline(always)]
+            fn precise_lane(self, i: usize) -> f64 {
+                self.as_array()[i] as f64
+            }
+            #[inline(always)]
+            fn with_lane(self, i: usize, v: f32) -> Self {
+                let mut a = self.to_array();
+                a[i] = v;
+                $t::new(a)
+            }
+        }
+    };
+}
+
+wide_lane!(f32x4, 4);
+wide_lane!(f32x8, 8);
+wide_lane!(f32x16, 16);
+
+/// `if mask { a } else { b }` for index arrays, lane by lane (only lanes set in `mask` change).
+#[inline(always)]
+pub(crate) fn select_indices<L: Lane>(mask: L::Mask, a: u32, b: &mut L::Indices) {
+    let mut bits = mask.bits();
+    let out = b.as_mut();
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        out[i] = a;
+        bits &= bits - 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check_width<L: Lane<Scalar = f32>>() {
+        let a = L::from_fn(|i| i as f32 - 1.5);
+        let b = L::splat(0.25);
+        let m = a.gt(b);
+        for i in 0..L::LANES {
+            assert_eq!(m.test(i), (i as f32 - 1.5) > 0.25);
+            assert_eq!(
+                L::select(m, a, b).lane(i),
+                if m.test(i) { a.lane(i) } else { 0.25 }
+            );
+        }
+        assert_eq!((<L::Mask as Mask>::splat(true) & m).bits(), m.bits());
+        let nan = L::splat(f32::NAN);
+        assert!(nan.lt(nan).none() && nan.ge(nan).none());
+        assert!(nan.is_finite().none() && L::splat(f32::INFINITY).is_finite().none());
+        assert!(b.is_finite().all());
+        assert_eq!(
+            L::splat(2.0).sqrt().lane(L::LANES - 1),
+            core::f32::consts::SQRT_2
+        );
+        assert_eq!(a.with_lane(0, 7.0).lane(0), 7.0);
+    }
+
+    #[test]
+    fn widths_agree_with_scalar() {
+        check_width::<f32>();
+        check_width::<f32x4>();
+        check_width::<f32x8>();
+        check_width::<f32x16>();
+    }
+}

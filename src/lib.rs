@@ -1,0 +1,65 @@
+//! # raylane
+//!
+//! Ray–sphere, ray–plane (and, with the triangle module, ray–triangle) intersection kernels
+//! that test many rays at once in SIMD lanes, spend as few floating-point operations as the
+//! mathematics allows, and give the same bits on x86-64, AArch64 and Cortex-M.
+//!
+//! * **One body of math per kernel.** Every kernel is a generic function over [`Lane`]:
+//!   `f32` (the scalar reference), `f64`, `wide::f32x4`/`f32x8`/`f32x16` packets, and
+//!   [`Counted`](opcount::Counted), which counts the operations the body performs.
+//! * **Same bits everywhere.** Only correctly rounded IEEE-754 operations, in an order the
+//!   generic body fixes, no fused multiply-add: every lane of every width equals the scalar
+//!   path bit for bit, on every target.
+//! * **No panics, no allocation.** Bad input (NaN, infinity, zero direction, non-positive
+//!   radius, degenerate primitives) is a documented miss; caches live in caller storage.
+//!
+//! ## Conventions
+//!
+//! * A ray is `o + t·d` over an open interval: a hit needs `t_min < t < t_max`
+//!   ([`Ray::new`] uses `(0, +inf)`). `t` is in units of `|d|`.
+//! * Directions need not be unit length, except for the methods that say so:
+//!   [`sphere::QuadraticUnit`], [`sphere::Geometric`] and the focal caches
+//!   ([`sphere::focal`]). Those normalise nothing.
+//! * Sphere kernels return every root inside the interval, ascending.
+//! * Misses are canonical: `t = +inf`, index `u32::MAX`; no hit record ever holds a NaN.
+//!
+//! ## Layout
+//!
+//! [`lane`] (the abstraction), [`vec3`] (`V3<L>`, SoA vectors), [`ray`] (rays and packets),
+//! [`camera`] (pinhole primary rays from one focal point), [`sphere`], [`plane`], [`hit`]
+//! (records and the closest/any loops), [`opcount`] (the counting lane), and, behind the
+//! `vectors` feature, [`vectors`] (the test-vector parser, runner and digest shared by the
+//! checker, the tests and the firmware).
+//!
+//! ## Example
+//!
+//! ```
+//! use glam::Vec3;
+//! use raylane::{Ray, sphere::{self, Sphere, Robust}};
+//!
+//! let ray = Ray::new(Vec3::new(1.0, 0.0, 1.0), Vec3::new(1.0, 2.0, 1.0));
+//! let ball = Sphere::new(Vec3::splat(5.0), 3.0);
+//! let hit = sphere::intersect::<Robust>(&ray, &ball).unwrap();
+//! assert!((ray.at(hit.t) - Vec3::new(3.0, 4.0, 3.0)).length() < 1e-5);
+//! ```
+
+#![no_std]
+#![deny(missing_docs)]
+#![forbid(unsafe_op_in_unsafe_fn)]
+
+pub mod camera;
+pub mod hit;
+pub mod lane;
+pub mod opcount;
+pub mod plane;
+pub mod ray;
+pub mod sphere;
+pub mod vec3;
+#[cfg(feature = "vectors")]
+pub mod vectors;
+
+pub use camera::Pinhole;
+pub use hit::{Hit, HitRecord, LaneHit};
+pub use lane::{Lane, Mask};
+pub use ray::{Ray, Ray4, Ray8, Ray16, RayPacket};
+pub use vec3::V3;

@@ -1,0 +1,398 @@
+//! Rays from one focal point: per-sphere caches with a precision guard.
+//!
+//! Primary rays of a pinhole camera all start at the focal point `E` (lecture 000, "Rays from
+//! Focal Point": *intermediate values remain constant across all pixels*). Per sphere the cache
+//! holds `T = C − E` and thresholds computed once, in `f64`, by [`FocalSphere::new`]; per ray
+//! with unit direction `U` the test is
+//!
+//! ```text
+//! v  = T·U                          3 mul, 2 add
+//! v² > k_lo ?                       1 mul, 1 cmp      → miss: 4 mul, 2 add, 1 cmp
+//! ```
+//!
+//! where `k_lo = K − E₁`, `K = c² − r²` (the lecture's `r² > c² − v²` with `c² − r²` folded into
+//! one cached value, one addition fewer than the lecture's 4 mul + 3 add), and `E₁` bounds the
+//! f32 rounding error of `v²` (`≈ 9.2·2^-24·c²`) plus the error allowed in `|U|² = 1`
+//! (`2^-20`). Below `k_lo` the miss is certain.
+//!
+//! **The guard.** Rays that pass the cheap test are decided by the perpendicular form of the
+//! precision lecture, reusing `v`: `p = T − vU`, `l² = p·p` (6 mul, 5 add). Subtracting before
+//! squaring keeps the error of `l²` near `4·2^-24·c·r` instead of `9·2^-24·c²`. Two more cached
+//! thresholds, derived from a rounding-error bound, make `l² ≤ l2_hit` a certain hit whose
+//! `t = v ∓ √(r² − l²)` is within `2^-17` relative of the exact root, and `l² ≥ l2_miss` a
+//! certain miss. Only lanes in between — rays grazing the rim within that bound, or spheres so
+//! close to the eye that `t` itself is ill-conditioned — are recomputed with the [`Robust`]
+//! body in `f64` (one lane at a time, then rounded to f32). The result: zero misclassified
+//! rays for `c/r` up to 2^20 and beyond, on every ray whose exact answer survives a 2-ulp move
+//! of the inputs, at the unguarded miss cost.
+//!
+//! Why not `d = √(v² − K)` for hits, as in the lecture? Its error `≈ 9·2^-24·c²/(2d)` exceeds
+//! 1e-5 of `t` once `c/r` passes about 5; the sphere of the precision lecture vanishes at 4096.
+//! [`FocalUnguarded`] keeps that textbook form (for comparison and benchmarks).
+//!
+//! **Operation count per lane** (measured): miss 4 mul, 2 add, 1 cmp; hit 10 mul, 10 add,
+//! 1 sqrt, 7 cmp; a doubtful lane adds one `f64` evaluation of [`Robust`].
+//!
+//! **Requirements.** Rays start exactly at the eye the cache was built for and have unit
+//! directions (`||U|² − 1| ≤ 2^-20`, which any f32 `normalize` meets; [`Pinhole`] makes such
+//! rays). **Edge cases.** Invalid spheres (see [`Sphere::new`]) and a non-finite eye give
+//! `k_lo = +inf`: never hit. Coordinates beyond `2^60` or radii below `2^-40` send every ray to
+//! the `f64` path.
+//!
+//! [`Robust`]: super::Robust
+//! [`Pinhole`]: crate::camera::Pinhole
+//! [`Sphere::new`]: super::Sphere::new
+
+use glam::Vec3;
+
+use super::{Robust, Roots, Sphere, SphereKernel, SpherePacket};
+use crate::hit::{self, HitRecord};
+use crate::lane::{Lane, Mask};
+use crate::ray::{Ray, RayPacket};
+use crate::vec3::V3;
+
+/// Unit roundoff of f32.
+const U: f64 = 1.0 / 16_777_216.0;
+/// Allowed deviation of `|U|²` from 1.
+const ETA: f64 = 1.0 / 1_048_576.0;
+/// Relative accuracy promised for `t` on the f32 hit path.
+const EPS_T: f64 = 1.0 / 131_072.0;
+/// Relative error of the f64 cache arithmetic (generous).
+const F64_REL: f64 = 1.0 / 1_125_899_906_842_624.0; // 2^-50
+/// Absolute floor for f32 underflow in products.
+const ABS: f64 = 1e-36;
+
+/// One sphere as seen from one focal point (or `L::LANES` spheres in lanes).
+///
+/// Build with [`FocalSphere::new`] (guarded) or [`FocalSphere::unguarded`], then [`splat`] it
+/// for packets of rays or [`gather`]/[`pack`] several into lanes for one ray against many.
+///
+/// [`splat`]: FocalSphere::splat
+/// [`gather`]: FocalSphere::gather
+/// [`pack`]: FocalSphere::pack
+#[derive(Clone, Copy, Debug)]
+pub struct FocalSphere<L: Lane> {
+    /// `T = C − E`, rounded to f32.
+    t: V3<L>,
+    /// Certain miss when `v² ≤ k_lo` (guarded); `K = c² − r²` itself when unguarded.
+    k_lo: L,
+    /// `r²` rounded to f32.
+    r2: L,
+    /// Certain, accurate hit when `l² ≤ l2_hit`.
+    l2_hit: L,
+    /// Certain miss when `l² ≥ l2_miss`.
+    l2_miss: L,
+    /// The sphere, for the `f64` fallback.
+    center: V3<L>,
+    radius: L,
+}
+
+fn sq(x: f64) -> f64 {
+    x * x
+}
+
+/// Rounds toward −inf.
+fn down(x: f64) -> f32 {
+    let y = x as f32;
+    if (y as f64) > x { y.next_down() } else { y }
+}
+
+/// Rounds toward +inf.
+fn up(x: f64) -> f32 {
+    let y = x as f32;
+    if (y as f64) < x { y.next_up() } else { y }
+}
+
+impl FocalSphere<f32> {
+    /// The guarded cache entry of `sphere` for rays from `eye` (see the [module docs](self)).
+    #[must_use]
+    pub fn new(eye: Vec3, sphere: &Sphere) -> Self {
+        Self::build(eye, sphere, true)
+    }
+
+    /// The lecture's unguarded entry: `k_lo = K` and hits from `√(v² − K)` (fails for far
+    /// small spheres; for comparison).
+    #[must_use]
+    pub fn unguarded(eye: Vec3, sphere: &Sphere) -> Self {
+        Self::build(eye, sphere, false)
+    }
+
+    fn build(eye: Vec3, sphere: &Sphere, guarded: bool) -> Self {
+        let (center, radius) = (sphere.center(), sphere.radius());
+        let te = [
+            center.x as f64 - eye.x as f64,
+            center.y as f64 - eye.y as f64,
+            center.z as f64 - eye.z as f64,
+        ];
+        let c2 = te[0] * te[0] + te[1] * te[1] + te[2] * te[2];
+        let r = radius as f64;
+        let r2e = r * r;
+        let k = c2 - r2e;
+        let t = V3::new(te[0] as f32, te[1] as f32, te[2] as f32);
+        let r2 = (r2e as f32).max(0.0);
+        let entry = |k_lo: f32, l2_hit: f32, l2_miss: f32| FocalSphere {
+            t,
+            k_lo,
+            r2,
+            l2_hit,
+            l2_miss,
+            center: center.into(),
+            radius,
+        };
+        if !(sphere.is_valid() && eye.is_finite()) {
+            return entry(f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY);
+        }
+        if !guarded {
+            return entry(k as f32, f32::NEG_INFINITY, f32::INFINITY);
+        }
+        let c = libm::sqrt(c2);
+        if !(c <= 1.0e18 && (1.0e-12..=1.0e18).contains(&r)) {
+            // Squares would leave f32's range: every ray takes the f64 path.
+            return entry(f32::NEG_INFINITY, f32::NEG_INFINITY, f32::INFINITY);
+        }
+        let n1 = 1.0 + ETA;
+        // Step 1. |v_c − v| ≤ dv (T rounded once, three products, two sums), and the bound E₁ on
+        // |fl(v_c²) − |U|²K − disc| that makes v² ≤ K − E₁ a certain miss.
+        let dv = 4.02 * U * c * libm::sqrt(n1);
+        let e1 = 9.2 * U * c2 * n1 + (ETA + F64_REL) * (c2 + r2e) + ABS;
+        let k_lo = down(k - e1);
+        // Step 2. p_c = p + αU + w with p ⊥ U, |α| ≤ α_max (dv and the non-unit |U|), |w| ≤ W0 +
+        // 2^-24|p_c| (roundings of T, vU and the subtraction). Then |l_c| lies within W of
+        // √(l² + α²|U|²), which bounds l from both sides.
+        let alpha = dv + c * libm::sqrt(n1) * ETA / (1.0 - ETA);
+        let a2 = alpha * alpha * n1;
+        let w0 = 2.01 * U * c * n1 + 1e-18;
+        let g3 = 3.01 * U;
+        let l2_miss =
+            up(sq((libm::sqrt(r2e + a2) + w0) / (1.0 - U)) * (1.0 + g3) * (1.0 + F64_REL));
+        let l2_sure = if r > w0 {
+            sq((r - w0) / (1.0 + U)) * (1.0 - g3) * (1.0 - F64_REL)
+        } else {
+            -1.0
+        };
+        // Step 3. Accuracy of t = v ∓ √(r² − l²) on a certain hit: |t_c − t| ≤ α + E_X/√X + (2u+η)(c+r),
+        // with E_X the error of X = r² − l²; require ≤ 2^-17·t_low, t_low ≤ |t| for both roots.
+        let a = libm::sqrt(a2);
+        let wp = w0 + 1.01 * U * (r + a + w0);
+        let e_l2 = a2 + 2.0 * wp * (r + a) + wp * wp + g3 * sq(r + a + wp);
+        let e_x = 1.01 * e_l2 + 2.01 * U * r2e;
+        let t_low = k.abs() / (2.0 * (c + r));
+        let budget = EPS_T * t_low - alpha - 1.01 * (2.0 * U + ETA) * (c + r) * n1;
+        let l2_acc = if budget > 0.0 {
+            r2e * (1.0 - U) - sq(e_x / budget) - e_x
+        } else {
+            -1.0
+        };
+        let l2_hit = l2_sure.min(l2_acc);
+        entry(
+            k_lo,
+            if l2_hit >= 0.0 {
+                down(l2_hit)
+            } else {
+                f32::NEG_INFINITY
+            },
+            l2_miss,
+        )
+    }
+}
+
+impl<L: Lane> FocalSphere<L> {
+    /// The same entry in every lane (N rays × 1 sphere).
+    #[inline(always)]
+    #[must_use]
+    pub fn splat(e: &FocalSphere<f32>) -> Self {
+        FocalSphere {
+            t: V3::splat(e.t.into()),
+            k_lo: L::from_f32(e.k_lo),
+            r2: L::from_f32(e.r2),
+            l2_hit: L::from_f32(e.l2_hit),
+            l2_miss: L::from_f32(e.l2_miss),
+            center: V3::splat(e.center.into()),
+            radius: L::from_f32(e.radius),
+        }
+    }
+
+    /// Up to `L::LANES` entries, one per lane (1 ray × N spheres); missing lanes never hit.
+    #[must_use]
+    pub fn gather(entries: &[FocalSphere<f32>]) -> Self {
+        let never = FocalSphere::<f32>::new(Vec3::ZERO, &Sphere::new(Vec3::ZERO, f32::NAN));
+        let get = |i: usize| entries.get(i).copied().unwrap_or(never);
+        FocalSphere {
+            t: V3::from_fn(|i| get(i).t.into()),
+            k_lo: L::from_f32_fn(|i| get(i).k_lo),
+            r2: L::from_f32_fn(|i| get(i).r2),
+            l2_hit: L::from_f32_fn(|i| get(i).l2_hit),
+            l2_miss: L::from_f32_fn(|i| get(i).l2_miss),
+            center: V3::from_fn(|i| get(i).center.into()),
+            radius: L::from_f32_fn(|i| get(i).radius),
+        }
+    }
+
+    /// Packs entries into `out` in chunks of `L::LANES`; returns the number of chunks written.
+    pub fn pack(entries: &[FocalSphere<f32>], out: &mut [FocalSphere<L>]) -> usize {
+        let mut n = 0;
+        for (chunk, slot) in entries.chunks(L::LANES).zip(out.iter_mut()) {
+            *slot = Self::gather(chunk);
+            n += 1;
+        }
+        n
+    }
+
+    /// The sphere in each lane.
+    #[inline]
+    #[must_use]
+    pub fn sphere(&self) -> SpherePacket<L> {
+        SpherePacket {
+            center: self.center,
+            radius: self.radius,
+        }
+    }
+}
+
+/// Builds the guarded cache of `spheres` for rays from `eye` into `out` (no allocation);
+/// returns the number of entries written (`min(spheres.len(), out.len())`).
+pub fn focus(eye: Vec3, spheres: &[Sphere], out: &mut [FocalSphere<f32>]) -> usize {
+    let mut n = 0;
+    for (s, slot) in spheres.iter().zip(out.iter_mut()) {
+        *slot = FocalSphere::new(eye, s);
+        n += 1;
+    }
+    n
+}
+
+/// A focal-point sphere test over [`FocalSphere`] caches.
+pub trait FocalKernel {
+    /// The method's name.
+    const NAME: &'static str;
+    /// All roots of ray lanes (starting at the cache's eye, unit directions) against the cached
+    /// sphere in each lane, ascending, inside the ray's interval.
+    fn roots<L: Lane>(ray: &RayPacket<L>, s: &FocalSphere<L>) -> Roots<L>;
+}
+
+/// The guarded focal test (the default; see the [module docs](self)).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Focal;
+
+/// The lecture's unguarded focal test: `v² > K`, `t = v ∓ √(v² − K)`. Miss 4 mul, 2 add,
+/// 1 cmp; hit adds 1 sqrt and 3 add. Misclassifies far small spheres (`c/r` beyond about
+/// 2^11) and loses accuracy in `t` from `c/r ≈ 5`. Build its cache with
+/// [`FocalSphere::unguarded`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct FocalUnguarded;
+
+impl FocalKernel for Focal {
+    const NAME: &'static str = "focal";
+    #[inline(always)]
+    fn roots<L: Lane>(ray: &RayPacket<L>, s: &FocalSphere<L>) -> Roots<L> {
+        focal::<L, true>(ray, s)
+    }
+}
+
+impl FocalKernel for FocalUnguarded {
+    const NAME: &'static str = "focal-unguarded";
+    #[inline(always)]
+    fn roots<L: Lane>(ray: &RayPacket<L>, s: &FocalSphere<L>) -> Roots<L> {
+        focal::<L, false>(ray, s)
+    }
+}
+
+/// One body for both; `GUARDED` selects the perpendicular hit path and the fallback.
+#[inline(always)]
+fn focal<L: Lane, const GUARDED: bool>(ray: &RayPacket<L>, s: &FocalSphere<L>) -> Roots<L> {
+    // 1. Foot of the perpendicular, and the cheap test against the cached threshold.
+    let v = s.t.dot(ray.dir);
+    let v2 = v * v;
+    let maybe = v2.gt(s.k_lo);
+    if maybe.none() {
+        return Roots::miss();
+    }
+    if !GUARDED {
+        let d = (v2 - s.k_lo).sqrt();
+        return Roots::in_interval(ray, v - d, v + d, maybe);
+    }
+    // 2. Perpendicular from the centre to the ray: p = T − vU, l² = p·p.
+    let l2 = (s.t - ray.dir.scale(v)).length_squared();
+    let sure_hit = maybe & l2.le(s.l2_hit);
+    let sure_miss = l2.ge(s.l2_miss);
+    // 3. Half chord and both roots of the certain hits.
+    let d = (s.r2 - l2).sqrt();
+    let roots = Roots::in_interval(ray, v - d, v + d, sure_hit);
+    // 4. Lanes the guard cannot decide: the robust body in f64, one lane at a time.
+    let doubtful = maybe.and_not(sure_hit | sure_miss);
+    if doubtful.none() {
+        roots
+    } else {
+        precise(ray, &s.sphere(), roots, doubtful)
+    }
+}
+
+/// Recomputes the `doubtful` lanes with [`Robust`] in `L::Precise` (`f64`).
+#[inline(never)]
+fn precise<L: Lane>(
+    ray: &RayPacket<L>,
+    s: &SpherePacket<L>,
+    mut roots: Roots<L>,
+    doubtful: L::Mask,
+) -> Roots<L> {
+    let mut bits = doubtful.bits();
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        let p = Robust::roots(&ray.precise_lane(i), &s.precise_lane(i));
+        roots = roots.with_precise_lane(i, ray, &p);
+        bits &= bits - 1;
+    }
+    roots
+}
+
+/// Closest hit of ray packets from the cache's eye over cached spheres (N rays × 1 sphere).
+#[inline]
+#[must_use]
+pub fn closest<K: FocalKernel, L: Lane>(
+    rays: &RayPacket<L>,
+    cache: &[FocalSphere<f32>],
+) -> hit::Hit<L> {
+    hit::closest(rays, cache, |r, e| {
+        K::roots(r, &FocalSphere::splat(e)).first()
+    })
+}
+
+/// Lanes whose ray hits some cached sphere (occlusion).
+#[inline]
+#[must_use]
+pub fn any<K: FocalKernel, L: Lane>(rays: &RayPacket<L>, cache: &[FocalSphere<f32>]) -> L::Mask {
+    hit::any(rays, cache, |r, e| {
+        K::roots(r, &FocalSphere::splat(e)).first()
+    })
+}
+
+/// Every root of every cached sphere some lane hits: `f(index, roots)`.
+#[inline]
+pub fn all<K: FocalKernel, L: Lane>(
+    rays: &RayPacket<L>,
+    cache: &[FocalSphere<f32>],
+    mut f: impl FnMut(u32, &Roots<L>),
+) {
+    for (i, e) in cache.iter().enumerate() {
+        let r = K::roots(rays, &FocalSphere::splat(e));
+        if r.any().any() {
+            f(i as u32, &r);
+        }
+    }
+}
+
+/// Closest hit of one ray from the eye over cached spheres packed in lanes (1 ray × N).
+#[inline]
+#[must_use]
+pub fn closest_soa<K: FocalKernel, L: Lane>(
+    ray: &Ray,
+    cache: &[FocalSphere<L>],
+) -> Option<HitRecord> {
+    hit::closest_soa(ray, cache, |r, e| K::roots(r, e).first())
+}
+
+/// True when one ray from the eye hits some cached sphere packed in lanes.
+#[inline]
+#[must_use]
+pub fn any_soa<K: FocalKernel, L: Lane>(ray: &Ray, cache: &[FocalSphere<L>]) -> bool {
+    hit::any_soa(ray, cache, |r, e| K::roots(r, e).first())
+}

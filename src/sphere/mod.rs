@@ -1,0 +1,368 @@
+//! Ray–sphere intersection: four formulations over one lane abstraction.
+//!
+//! | kernel | from | directions | strength |
+//! | --- | --- | --- | --- |
+//! | [`Quadratic`] | the general quadratic (lecture 004, `AppendAllIntersections`) | any | the textbook; fails for far small spheres and near roots of huge spheres |
+//! | [`QuadraticUnit`] | the brute force of lecture 000 with `a = 1` | unit | the lecture's operation count |
+//! | [`Geometric`] | the lecture's "faster method" (Glassner) | unit | fewest operations for a single ray |
+//! | [`Robust`] | Ray Tracing Gems ch. 7 (precision lecture 001) | any | perpendicular-distance discriminant, stable roots |
+//! | [`focal`] | rays from one focal point, cached per sphere, with a precision guard | unit | 4 mul + 2 add per miss, exact hit/miss decisions to c/r = 2^20 |
+//!
+//! Every kernel returns all roots inside the ray's open interval, ascending ([`Roots`]): both
+//! the entry and the exit point when the origin is outside, only the exit when it is inside.
+//! [`surface`] gives the point, the unit outward normal and the squared distance for a root.
+//!
+//! Entry points: [`closest`], [`any`], [`all`] for ray packets over a slice of spheres (N rays ×
+//! 1 sphere), [`closest_soa`] for one ray over spheres stored in lanes (1 ray × N spheres), and
+//! [`intersect`] for one ray and one sphere. The focal caches have the same set in [`focal`].
+//!
+//! Bad input: a sphere with a non-finite centre or a radius that is not a finite positive
+//! number is stored with a NaN radius by [`Sphere::new`] and never hit; bad rays are
+//! sanitised by their constructors (see [`ray`](crate::ray)).
+
+pub mod focal;
+mod geometric;
+mod quadratic;
+mod robust;
+
+pub use geometric::{Geometric, Prepared};
+pub use quadratic::{Quadratic, QuadraticUnit};
+pub use robust::Robust;
+
+pub use focal::FocalSphere;
+
+use glam::Vec3;
+
+use crate::hit::{self, HitRecord, LaneHit};
+use crate::lane::{Lane, Mask, Scalar};
+use crate::ray::{Ray, RayPacket};
+use crate::vec3::V3;
+
+/// A sphere: centre and radius.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sphere {
+    center: Vec3,
+    radius: f32,
+}
+
+impl Sphere {
+    /// A sphere; a non-finite centre or a radius that is not finite and positive gives a
+    /// sphere that is never hit (its radius is stored as NaN).
+    #[inline]
+    #[must_use]
+    pub fn new(center: Vec3, radius: f32) -> Self {
+        let ok = center.is_finite() && radius.is_finite() && radius > 0.0;
+        Sphere {
+            center,
+            radius: if ok { radius } else { f32::NAN },
+        }
+    }
+
+    /// The centre.
+    #[inline]
+    #[must_use]
+    pub fn center(&self) -> Vec3 {
+        self.center
+    }
+
+    /// The radius (NaN for a sphere made from bad input).
+    #[inline]
+    #[must_use]
+    pub fn radius(&self) -> f32 {
+        self.radius
+    }
+
+    /// False for a sphere made from bad input.
+    #[inline]
+    #[must_use]
+    pub fn is_valid(&self) -> bool {
+        !self.radius.is_nan()
+    }
+}
+
+/// Spheres in lanes (structure of arrays): lane `i` of each field is sphere `i`.
+#[derive(Clone, Copy, Debug)]
+pub struct SpherePacket<L: Lane> {
+    pub(crate) center: V3<L>,
+    pub(crate) radius: L,
+}
+
+impl<L: Lane> SpherePacket<L> {
+    /// The same sphere in every lane.
+    #[inline(always)]
+    #[must_use]
+    pub fn splat(s: &Sphere) -> Self {
+        SpherePacket {
+            center: V3::splat(s.center),
+            radius: L::from_f32(s.radius),
+        }
+    }
+
+    /// Up to `L::LANES` spheres, one per lane; lanes past `spheres.len()` are never hit.
+    #[must_use]
+    pub fn from_spheres(spheres: &[Sphere]) -> Self {
+        let get = |i: usize| {
+            spheres
+                .get(i)
+                .copied()
+                .unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN))
+        };
+        SpherePacket {
+            center: V3::from_fn(|i| get(i).center),
+            radius: L::from_f32_fn(|i| get(i).radius),
+        }
+    }
+
+    /// Fills `out` with `spheres` in chunks of `L::LANES` (the last chunk padded with spheres
+    /// that are never hit) and returns the number of chunks written (at most `out.len()`).
+    pub fn pack(spheres: &[Sphere], out: &mut [SpherePacket<L>]) -> usize {
+        let mut n = 0;
+        for (chunk, slot) in spheres.chunks(L::LANES).zip(out.iter_mut()) {
+            *slot = Self::from_spheres(chunk);
+            n += 1;
+        }
+        n
+    }
+
+    /// Centres.
+    #[inline]
+    #[must_use]
+    pub fn center(&self) -> V3<L> {
+        self.center
+    }
+
+    /// Radii (NaN in lanes that are never hit).
+    #[inline]
+    #[must_use]
+    pub fn radius(&self) -> L {
+        self.radius
+    }
+
+    /// Lane `i` as a single higher-precision sphere (exact widening; for fallbacks).
+    #[inline]
+    #[must_use]
+    pub fn precise_lane(&self, i: usize) -> SpherePacket<L::Precise> {
+        SpherePacket {
+            center: self.center.precise_lane(i),
+            radius: self.radius.precise_lane(i),
+        }
+    }
+}
+
+/// The roots of one ray–sphere test per lane, ascending, each flagged when it lies inside the
+/// ray's open interval. Roots outside the interval are stored as `+inf`.
+#[derive(Clone, Copy, Debug)]
+pub struct Roots<L: Lane> {
+    /// The smaller root (entry point), `+inf` unless `m0`.
+    pub t0: L,
+    /// The larger root (exit point), `+inf` unless `m1`.
+    pub t1: L,
+    /// Lanes where `t0` is inside the interval.
+    pub m0: L::Mask,
+    /// Lanes where `t1` is inside the interval.
+    pub m1: L::Mask,
+}
+
+impl<L: Lane> Roots<L> {
+    /// No root in any lane.
+    #[inline(always)]
+    #[must_use]
+    pub fn miss() -> Self {
+        let inf = L::from_f32(f32::INFINITY);
+        Roots {
+            t0: inf,
+            t1: inf,
+            m0: Mask::splat(false),
+            m1: Mask::splat(false),
+        }
+    }
+
+    /// From the two roots `lo <= hi` of lanes in `real` (real roots): keeps those inside the
+    /// ray's interval (4 compares).
+    #[inline(always)]
+    #[must_use]
+    pub fn in_interval(ray: &RayPacket<L>, lo: L, hi: L, real: L::Mask) -> Self {
+        let m0 = real & lo.gt(ray.t_min) & lo.lt(ray.t_max);
+        let m1 = real & hi.gt(ray.t_min) & hi.lt(ray.t_max);
+        let inf = L::from_f32(f32::INFINITY);
+        Roots {
+            t0: L::select(m0, lo, inf),
+            t1: L::select(m1, hi, inf),
+            m0,
+            m1,
+        }
+    }
+
+    /// The first root inside the interval per lane (the closest hit).
+    #[inline(always)]
+    #[must_use]
+    pub fn first(&self) -> LaneHit<L> {
+        let t = L::select(self.m0, self.t0, self.t1);
+        let zero = L::from_f32(0.0);
+        LaneHit {
+            t,
+            u: zero,
+            v: zero,
+            mask: self.m0 | self.m1,
+        }
+    }
+
+    /// Lanes with at least one root inside the interval.
+    #[inline(always)]
+    #[must_use]
+    pub fn any(&self) -> L::Mask {
+        self.m0 | self.m1
+    }
+
+    /// Lane `i` as up to two roots, ascending (`f32` lanes).
+    #[must_use]
+    pub fn lane(&self, i: usize) -> ([f32; 2], usize)
+    where
+        L: Lane<Scalar = f32>,
+    {
+        let mut out = [f32::INFINITY; 2];
+        let mut n = 0;
+        if self.m0.test(i) {
+            out[n] = self.t0.lane(i);
+            n += 1;
+        }
+        if self.m1.test(i) {
+            out[n] = self.t1.lane(i);
+            n += 1;
+        }
+        (out, n)
+    }
+
+    /// Replaces lane `i` with roots computed elsewhere (a higher-precision fallback), rounding
+    /// them to the lane's precision and re-checking them against the ray's interval.
+    #[inline(never)]
+    #[must_use]
+    pub(crate) fn with_precise_lane(
+        self,
+        i: usize,
+        ray: &RayPacket<L>,
+        p: &Roots<L::Precise>,
+    ) -> Self {
+        let (t_min, t_max) = (ray.t_min.lane(i), ray.t_max.lane(i));
+        let fit = |t: f64, m: bool| {
+            let t = L::Scalar::from_f64(t);
+            (m && t > t_min && t < t_max).then_some(t)
+        };
+        let inf = L::Scalar::from_f32(f32::INFINITY);
+        let r0 = fit(p.t0.lane(0), p.m0.test(0));
+        let r1 = fit(p.t1.lane(0), p.m1.test(0));
+        Roots {
+            t0: self.t0.with_lane(i, r0.unwrap_or(inf)),
+            t1: self.t1.with_lane(i, r1.unwrap_or(inf)),
+            m0: self.m0.with_lane(i, r0.is_some()),
+            m1: self.m1.with_lane(i, r1.is_some()),
+        }
+    }
+}
+
+/// A ray–sphere formulation: all roots of ray lanes against sphere lanes.
+///
+/// Implemented by [`Quadratic`], [`QuadraticUnit`], [`Geometric`] and [`Robust`]; one generic
+/// body each, shared by every lane width and by the op-counting lane.
+pub trait SphereKernel {
+    /// The method's name (as the checker spells it).
+    const NAME: &'static str;
+    /// True when the method needs unit-length directions.
+    const UNIT_DIRECTIONS: bool;
+    /// All roots of each ray lane against the sphere in the same lane, ascending, inside the
+    /// ray's interval.
+    fn roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Roots<L>;
+}
+
+/// Point, unit outward normal and squared distance from the ray origin of a root `t`
+/// (lecture 004: `point = D + uE`, `normal = (point − C)/|point − C|`, `distanceSquared =
+/// |uE|²`). The point costs 3 mul and 3 add; the normal 3 add, 3 mul, 2 add, 1 sqrt, 3 div;
+/// the distance² 3 mul, 2 add more.
+#[derive(Clone, Copy, Debug)]
+pub struct Surface<L: Lane> {
+    /// `o + t·d`.
+    pub point: V3<L>,
+    /// Unit normal pointing away from the centre.
+    pub normal: V3<L>,
+    /// `|t·d|²`: squared distance from the ray origin.
+    pub distance_squared: L,
+}
+
+/// Surface data of a root (see [`Surface`]).
+#[inline]
+#[must_use]
+pub fn surface<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>, t: L) -> Surface<L> {
+    let step = ray.dir.scale(t);
+    let point = ray.origin + step;
+    let out = point - sphere.center;
+    let normal = out.div_by(out.length_squared().sqrt());
+    Surface {
+        point,
+        normal,
+        distance_squared: step.length_squared(),
+    }
+}
+
+/// Closest hit of one ray and one sphere with kernel `K`: `(t, surface)`, or `None`.
+#[inline]
+#[must_use]
+pub fn intersect<K: SphereKernel>(ray: &Ray, sphere: &Sphere) -> Option<HitRecord> {
+    let h = K::roots(&RayPacket::<f32>::splat(ray), &SpherePacket::splat(sphere)).first();
+    h.mask.then_some(HitRecord {
+        t: h.t,
+        u: 0.0,
+        v: 0.0,
+        index: 0,
+    })
+}
+
+/// Closest hit of ray lanes over a slice of spheres with kernel `K` (N rays × 1 sphere).
+#[inline]
+#[must_use]
+pub fn closest<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) -> hit::Hit<L> {
+    hit::closest(rays, spheres, |r, s| {
+        K::roots(r, &SpherePacket::splat(s)).first()
+    })
+}
+
+/// Lanes whose ray hits some sphere (occlusion), with kernel `K`.
+#[inline]
+#[must_use]
+pub fn any<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) -> L::Mask {
+    hit::any(rays, spheres, |r, s| {
+        K::roots(r, &SpherePacket::splat(s)).first()
+    })
+}
+
+/// Every root of every sphere: calls `f(index, roots)` for each sphere that some lane hits.
+#[inline]
+pub fn all<K: SphereKernel, L: Lane>(
+    rays: &RayPacket<L>,
+    spheres: &[Sphere],
+    mut f: impl FnMut(u32, &Roots<L>),
+) {
+    for (i, s) in spheres.iter().enumerate() {
+        let r = K::roots(rays, &SpherePacket::splat(s));
+        if r.any().any() {
+            f(i as u32, &r);
+        }
+    }
+}
+
+/// Closest hit of one ray over spheres packed in lanes (1 ray × N spheres); the index is the
+/// sphere's position in the slice that was packed.
+#[inline]
+#[must_use]
+pub fn closest_soa<K: SphereKernel, L: Lane>(
+    ray: &Ray,
+    spheres: &[SpherePacket<L>],
+) -> Option<HitRecord> {
+    hit::closest_soa(ray, spheres, |r, s| K::roots(r, s).first())
+}
+
+/// True when one ray hits some sphere packed in lanes.
+#[inline]
+#[must_use]
+pub fn any_soa<K: SphereKernel, L: Lane>(ray: &Ray, spheres: &[SpherePacket<L>]) -> bool {
+    hit::any_soa(ray, spheres, |r, s| K::roots(r, s).first())
+}

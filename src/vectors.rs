@@ -1,0 +1,721 @@
+//! Test vectors: parser, batched runner, per-method limits, comparison and digest.
+//!
+//! One implementation, no allocation, shared by the checker (`examples/check.rs`), the host
+//! tests and the firmware under `targets/`. The files under `tests/vectors/` hold one case a
+//! line (`#` starts a comment):
+//!
+//! ```text
+//! sphere   ox oy oz  dx dy dz  cx cy cz  r                -> miss | t0 [t1]
+//! plane    ox oy oz  dx dy dz  px py pz  nx ny nz         -> miss | t
+//! triangle ox oy oz  dx dy dz  ax ay az  bx by bz  cx cy cz -> miss | t u v
+//! ```
+//!
+//! The ray interval is `(0, +inf)`; sphere expectations list every root in it, ascending.
+//!
+//! [`evaluate`] runs cases through one [`Method`] at one lane width, batching consecutive cases
+//! of a kind into the lanes (so lane independence is tested too). [`compare`] checks an outcome
+//! against the expectation: `t` within a relative [`T_TOLERANCE`], barycentrics within an
+//! absolute [`UV_TOLERANCE`], and the same hit/miss. A case outside a method's documented
+//! limits ([`Method::limits`]) is reported as such, not compared.
+
+use core::fmt;
+
+use glam::Vec3;
+
+use crate::lane::{Lane, Mask};
+use crate::plane::{self, FocalPlane, Plane, PlanePacket};
+use crate::ray::RayPacket;
+use crate::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
+use crate::sphere::{
+    FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Roots, Sphere, SphereKernel,
+    SpherePacket,
+};
+use crate::vec3::V3;
+
+/// Relative tolerance on `t`.
+pub const T_TOLERANCE: f64 = 2e-5;
+/// Absolute tolerance on the barycentrics `u`, `v`.
+pub const UV_TOLERANCE: f64 = 2e-5;
+
+/// The primitive a case tests.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kind {
+    /// `sphere` lines: 10 inputs.
+    Sphere,
+    /// `plane` lines: 12 inputs.
+    Plane,
+    /// `triangle` lines: 15 inputs.
+    Triangle,
+}
+
+impl Kind {
+    /// The keyword that starts the line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Sphere => "sphere",
+            Kind::Plane => "plane",
+            Kind::Triangle => "triangle",
+        }
+    }
+
+    /// Number of input numbers.
+    #[must_use]
+    pub fn inputs(self) -> usize {
+        match self {
+            Kind::Sphere => 10,
+            Kind::Plane => 12,
+            Kind::Triangle => 15,
+        }
+    }
+}
+
+/// A result: `miss`, or up to three values (`t0 [t1]` for spheres, `t` for planes, `t u v`
+/// for triangles).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Values {
+    /// How many of `v` are used; 0 is a miss.
+    pub n: u8,
+    /// The values.
+    pub v: [f32; 3],
+}
+
+impl Values {
+    /// A miss.
+    pub const MISS: Values = Values { n: 0, v: [0.0; 3] };
+
+    /// The used values.
+    #[must_use]
+    pub fn as_slice(&self) -> &[f32] {
+        &self.v[..self.n as usize]
+    }
+}
+
+impl fmt::Display for Values {
+    /// `miss`, or the values separated by spaces, each the shortest decimal that reads back
+    /// to the same f32.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.n == 0 {
+            return f.write_str("miss");
+        }
+        for (i, x) in self.as_slice().iter().enumerate() {
+            if i > 0 {
+                f.write_str(" ")?;
+            }
+            write_shortest(f, *x)?;
+        }
+        Ok(())
+    }
+}
+
+/// Writes `x` as its shortest round-trip decimal (plain notation for moderate magnitudes,
+/// scientific otherwise).
+pub fn write_shortest(f: &mut impl fmt::Write, x: f32) -> fmt::Result {
+    let a = x.abs();
+    if x == 0.0 || (1e-4..1e16).contains(&a) || !x.is_finite() {
+        write!(f, "{x}")
+    } else {
+        write!(f, "{x:e}")
+    }
+}
+
+/// One parsed line.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Case {
+    /// The primitive.
+    pub kind: Kind,
+    /// The inputs (the first [`Kind::inputs`] are used).
+    pub input: [f32; 15],
+    /// The expected result.
+    pub expect: Values,
+    /// Line number in its file (1-based).
+    pub line: u32,
+}
+
+impl Case {
+    /// Ray origin.
+    #[must_use]
+    pub fn origin(&self) -> Vec3 {
+        Vec3::new(self.input[0], self.input[1], self.input[2])
+    }
+    /// Ray direction.
+    #[must_use]
+    pub fn dir(&self) -> Vec3 {
+        Vec3::new(self.input[3], self.input[4], self.input[5])
+    }
+    /// Input vector `k` after the ray (0: centre / point / A, 1: normal / B, 2: C).
+    #[must_use]
+    pub fn vec(&self, k: usize) -> Vec3 {
+        let i = 6 + 3 * k;
+        Vec3::new(self.input[i], self.input[i + 1], self.input[i + 2])
+    }
+    /// The sphere of a sphere case.
+    #[must_use]
+    pub fn sphere(&self) -> Sphere {
+        Sphere::new(self.vec(0), self.input[9])
+    }
+    /// The plane of a plane case.
+    #[must_use]
+    pub fn plane(&self) -> Plane {
+        Plane::new(self.vec(0), self.vec(1))
+    }
+}
+
+/// Why a line could not be read.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ParseError {
+    /// The first word is not `sphere`, `plane` or `triangle`.
+    UnknownKind,
+    /// Wrong number of inputs before `->`.
+    InputCount,
+    /// A number did not parse.
+    Number,
+    /// No `->`, or a bad expectation.
+    Expectation,
+}
+
+/// Parses one line: `None` for blank and comment lines.
+#[must_use]
+pub fn parse_line(line: &str, number: u32) -> Option<Result<Case, ParseError>> {
+    let s = line.trim();
+    if s.is_empty() || s.starts_with('#') {
+        return None;
+    }
+    Some(parse_case(s, number))
+}
+
+fn parse_case(s: &str, line: u32) -> Result<Case, ParseError> {
+    let (lhs, rhs) = s.split_once("->").ok_or(ParseError::Expectation)?;
+    let mut words = lhs.split_ascii_whitespace();
+    let kind = match words.next() {
+        Some("sphere") => Kind::Sphere,
+        Some("plane") => Kind::Plane,
+        Some("triangle") => Kind::Triangle,
+        _ => return Err(ParseError::UnknownKind),
+    };
+    let mut input = [0f32; 15];
+    let mut n = 0;
+    for w in words {
+        if n == kind.inputs() {
+            return Err(ParseError::InputCount);
+        }
+        input[n] = w.parse().map_err(|_| ParseError::Number)?;
+        n += 1;
+    }
+    if n != kind.inputs() {
+        return Err(ParseError::InputCount);
+    }
+    let rhs = rhs.split('#').next().unwrap_or("").trim();
+    let expect = if rhs == "miss" {
+        Values::MISS
+    } else {
+        let mut v = Values::MISS;
+        for w in rhs.split_ascii_whitespace() {
+            if v.n == 3 {
+                return Err(ParseError::Expectation);
+            }
+            v.v[v.n as usize] = w.parse().map_err(|_| ParseError::Expectation)?;
+            v.n += 1;
+        }
+        let want = match kind {
+            Kind::Sphere => v.n == 1 || v.n == 2,
+            Kind::Plane => v.n == 1,
+            Kind::Triangle => v.n == 3,
+        };
+        if !want {
+            return Err(ParseError::Expectation);
+        }
+        v
+    };
+    Ok(Case {
+        kind,
+        input,
+        expect,
+        line,
+    })
+}
+
+/// Iterates over the cases of a file's text: `(line number, result)`.
+pub fn cases(text: &str) -> impl Iterator<Item = (u32, Result<Case, ParseError>)> + '_ {
+    text.lines().enumerate().filter_map(|(i, l)| {
+        let n = i as u32 + 1;
+        parse_line(l, n).map(|r| (n, r))
+    })
+}
+
+/// A formulation, as the checker names it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Method {
+    /// [`Quadratic`]: spheres.
+    Quadratic,
+    /// [`QuadraticUnit`]: spheres, unit directions.
+    QuadraticUnit,
+    /// [`Geometric`]: spheres, unit directions.
+    Geometric,
+    /// [`Robust`]: spheres.
+    Robust,
+    /// The guarded focal caches: spheres ([`Focal`], unit directions) and planes
+    /// ([`FocalPlane`]).
+    Focal,
+    /// [`FocalUnguarded`]: spheres, unit directions.
+    FocalUnguarded,
+    /// The ray–plane test.
+    Plane,
+}
+
+impl Method {
+    /// Every method, in report order.
+    pub const ALL: [Method; 7] = [
+        Method::Quadratic,
+        Method::QuadraticUnit,
+        Method::Geometric,
+        Method::Robust,
+        Method::Focal,
+        Method::FocalUnguarded,
+        Method::Plane,
+    ];
+
+    /// The checker's name.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Quadratic => Quadratic::NAME,
+            Method::QuadraticUnit => QuadraticUnit::NAME,
+            Method::Geometric => Geometric::NAME,
+            Method::Robust => Robust::NAME,
+            Method::Focal => Focal::NAME,
+            Method::FocalUnguarded => FocalUnguarded::NAME,
+            Method::Plane => "plane",
+        }
+    }
+
+    /// Looks a name up.
+    #[must_use]
+    pub fn parse(name: &str) -> Option<Method> {
+        Method::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// True when the method tests this kind of primitive.
+    #[must_use]
+    pub fn applies(self, kind: Kind) -> bool {
+        match kind {
+            Kind::Sphere => !matches!(self, Method::Plane),
+            Kind::Plane => matches!(self, Method::Plane | Method::Focal),
+            Kind::Triangle => false,
+        }
+    }
+
+    /// The crate's recommended general method for a kind (any direction, any origin).
+    #[must_use]
+    pub fn recommended(kind: Kind) -> Option<Method> {
+        match kind {
+            Kind::Sphere => Some(Method::Robust),
+            Kind::Plane => Some(Method::Plane),
+            Kind::Triangle => None,
+        }
+    }
+
+    /// Whether a case lies inside the method's documented limits (see [`Limit`]).
+    #[must_use]
+    pub fn limits(self, case: &Case) -> Limit {
+        limits::check(self, case)
+    }
+}
+
+/// Whether a case is inside a method's documented limits.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Limit {
+    /// Inside: the result must match.
+    Inside,
+    /// Outside, with the documented reason.
+    Outside(&'static str),
+}
+
+mod limits {
+    //! The documented limits of each method, as predicates on a case's inputs (computed in
+    //! f64). They follow the error bounds in each kernel's documentation.
+
+    use super::{Case, Kind, Limit, Method, T_TOLERANCE};
+
+    const U: f64 = 1.0 / 16_777_216.0;
+
+    fn sqrt(x: f64) -> f64 {
+        libm::sqrt(x)
+    }
+
+    fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+        [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+    }
+    fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+        a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+    }
+    fn v(c: &Case, k: usize) -> [f64; 3] {
+        [
+            c.input[k] as f64,
+            c.input[k + 1] as f64,
+            c.input[k + 2] as f64,
+        ]
+    }
+
+    pub(super) fn check(m: Method, case: &Case) -> Limit {
+        if !m.applies(case.kind) {
+            return Limit::Outside("method does not apply to this kind");
+        }
+        // Bad input must be a miss for every method.
+        let all_finite = case.input[..case.kind.inputs()]
+            .iter()
+            .all(|x| x.is_finite());
+        if !all_finite || case.kind != Kind::Sphere {
+            return Limit::Inside;
+        }
+        let o = v(case, 0);
+        let d = v(case, 3);
+        let ctr = v(case, 6);
+        let r = case.input[9] as f64;
+        let a = dot(d, d);
+        if r.is_nan() || r <= 0.0 || a == 0.0 {
+            return Limit::Inside;
+        }
+        let unit = (a - 1.0).abs() <= 1.0 / 1_048_576.0;
+        let needs_unit = matches!(
+            m,
+            Method::QuadraticUnit | Method::Geometric | Method::Focal | Method::FocalUnguarded
+        );
+        if needs_unit && !unit {
+            return Limit::Outside("needs a unit direction");
+        }
+        // Geometry in f64: T = C − O, μ = d·T, c² = |T|², l² = perpendicular distance², the
+        // rim margin m = |r² − l²| and the roots.
+        let t = sub(ctr, o);
+        let mu = dot(d, t);
+        let c2 = dot(t, t);
+        let l2 = (c2 - mu * mu / a).max(0.0);
+        let margin = (r * r - l2).abs();
+        let disc_signed = mu * mu - a * (c2 - r * r);
+        let disc = disc_signed.max(0.0);
+        let roots = [(mu - sqrt(disc)) / a, (mu + sqrt(disc)) / a];
+        // Smallest root inside (0, inf); infinite for a miss (then only decisions matter).
+        let t_small = if disc_signed > 0.0 {
+            roots
+                .iter()
+                .filter(|t| **t > 0.0)
+                .fold(f64::INFINITY, |m, t| m.min(*t))
+        } else {
+            f64::INFINITY
+        };
+        let c = sqrt(c2);
+        let tol = 0.5 * T_TOLERANCE;
+        match m {
+            Method::Quadratic
+            | Method::QuadraticUnit
+            | Method::Geometric
+            | Method::FocalUnguarded => {
+                // The constant term c² − r² (or c² − v²) carries an error of about 16·2^-24·c²:
+                // decisions need the rim margin above twice that, and t's error
+                // E/(2√(margin)) + 4·2^-24·(|μ| + √disc) must stay within half the tolerance.
+                let e = 16.0 * U * c2 * a;
+                if margin * a < 2.0 * e {
+                    return Limit::Outside("within 32·2^-24·c² of the rim");
+                }
+                let err_t = (e / (2.0 * sqrt(margin * a)) + 4.0 * U * (mu.abs() + sqrt(disc))) / a;
+                if t_small.is_finite() && err_t > tol * t_small {
+                    return Limit::Outside("root error of the textbook form above tolerance");
+                }
+                Limit::Inside
+            }
+            Method::Robust => {
+                // |l| carries an error of about 8·2^-24·|f|; c = f·f − r² about 4·2^-24·|f|².
+                let el = 8.0 * U * c;
+                let l = sqrt(l2);
+                if (l - r).abs() < 2.0 * el {
+                    return Limit::Outside("within 16·2^-24·|f| of the rim");
+                }
+                if !t_small.is_finite() {
+                    return Limit::Inside;
+                }
+                let cc = (c2 - r * r).abs();
+                let sq = sqrt(a * disc);
+                let q = mu.abs() + sqrt(disc);
+                let e_root = a * (l + r) * el / sq.max(f64::MIN_POSITIVE);
+                let err0 = 4.0 * U * c2 / cc + e_root / q + 6.0 * U;
+                let err1 = e_root / q + 6.0 * U;
+                if err0.max(err1) > tol {
+                    return Limit::Outside("root error of the robust form above tolerance");
+                }
+                Limit::Inside
+            }
+            // Exact decisions and t within 2^-17 for unit directions and any c/r.
+            Method::Focal | Method::Plane => Limit::Inside,
+        }
+    }
+}
+
+/// A method's result for one case; `applicable` is false when the method does not test the
+/// case's kind.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Outcome {
+    /// False when the method does not test this kind.
+    pub applicable: bool,
+    /// The computed values (`n = 0`: a miss).
+    pub values: Values,
+}
+
+/// Evaluates `cases` with `method` at `lanes` lanes (1, 4, 8 or 16), writing `out[i]` for
+/// `cases[i]`. Consecutive cases of the same kind share a packet. Returns false (and writes
+/// nothing) for an unsupported lane count or when `out` is shorter than `cases`.
+pub fn evaluate(method: Method, lanes: usize, cases: &[Case], out: &mut [Outcome]) -> bool {
+    if out.len() < cases.len() {
+        return false;
+    }
+    match lanes {
+        1 => run::<f32>(method, cases, out),
+        4 => run::<wide::f32x4>(method, cases, out),
+        8 => run::<wide::f32x8>(method, cases, out),
+        16 => run::<wide::f32x16>(method, cases, out),
+        _ => return false,
+    }
+    true
+}
+
+fn run<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome]) {
+    let mut i = 0;
+    while i < cases.len() {
+        let kind = cases[i].kind;
+        let mut j = i;
+        while j < cases.len() && j - i < L::LANES && cases[j].kind == kind {
+            j += 1;
+        }
+        batch::<L>(method, &cases[i..j], &mut out[i..j]);
+        i = j;
+    }
+}
+
+/// Evaluates up to `L::LANES` cases of one kind in one packet.
+fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome]) {
+    let kind = cases[0].kind;
+    if !method.applies(kind) {
+        out.iter_mut().for_each(|o| *o = Outcome::default());
+        return;
+    }
+    let n = cases.len();
+    let get = |i: usize| cases[i.min(n - 1)];
+    let ray = RayPacket::<L>::new(
+        V3::from_fn(|i| get(i).origin()),
+        V3::from_fn(|i| get(i).dir()),
+        L::from_f32(0.0),
+        L::from_f32(f32::INFINITY),
+    );
+    match kind {
+        Kind::Sphere => {
+            let spheres = || SpherePacket::<L>::from_spheres(&sphere_list(cases));
+            let roots: Roots<L> = match method {
+                Method::Quadratic => Quadratic::roots(&ray, &spheres()),
+                Method::QuadraticUnit => QuadraticUnit::roots(&ray, &spheres()),
+                Method::Geometric => Geometric::roots(&ray, &spheres()),
+                Method::Robust => Robust::roots(&ray, &spheres()),
+                Method::Focal | Method::FocalUnguarded => {
+                    let mut e =
+                        [FocalSphere::<f32>::new(Vec3::ZERO, &Sphere::new(Vec3::ZERO, f32::NAN));
+                            16];
+                    for (k, c) in cases.iter().enumerate() {
+                        e[k] = if method == Method::Focal {
+                            FocalSphere::new(c.origin(), &c.sphere())
+                        } else {
+                            FocalSphere::unguarded(c.origin(), &c.sphere())
+                        };
+                    }
+                    let cache = FocalSphere::<L>::gather(&e[..n]);
+                    if method == Method::Focal {
+                        Focal::roots(&ray, &cache)
+                    } else {
+                        FocalUnguarded::roots(&ray, &cache)
+                    }
+                }
+                Method::Plane => Roots::miss(),
+            };
+            for (k, o) in out.iter_mut().enumerate() {
+                let (t, m) = roots.lane(k);
+                *o = Outcome {
+                    applicable: true,
+                    values: Values {
+                        n: m as u8,
+                        v: [t[0], t[1], 0.0],
+                    },
+                };
+            }
+        }
+        Kind::Plane => {
+            let h = if method == Method::Focal {
+                let num =
+                    L::from_f32_fn(|i| FocalPlane::new(get(i).origin(), &get(i).plane()).num());
+                plane::focal_lanes(&ray, num, V3::from_fn(|i| get(i).vec(1)))
+            } else {
+                let planes = PlanePacket::<L> {
+                    point: V3::from_fn(|i| get(i).vec(0)),
+                    normal: V3::from_fn(|i| get(i).vec(1)),
+                };
+                plane::intersect_lanes(&ray, &planes)
+            };
+            for (k, o) in out.iter_mut().enumerate() {
+                let values = if h.mask.test(k) {
+                    Values {
+                        n: 1,
+                        v: [h.t.lane(k), 0.0, 0.0],
+                    }
+                } else {
+                    Values::MISS
+                };
+                *o = Outcome {
+                    applicable: true,
+                    values,
+                };
+            }
+        }
+        Kind::Triangle => out.iter_mut().for_each(|o| *o = Outcome::default()),
+    }
+}
+
+fn sphere_list(cases: &[Case]) -> [Sphere; 16] {
+    let mut s = [Sphere::new(Vec3::ZERO, f32::NAN); 16];
+    for (k, c) in cases.iter().enumerate().take(16) {
+        s[k] = c.sphere();
+    }
+    s
+}
+
+/// The verdict on one case.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Verdict {
+    /// Same hit/miss, values within tolerance.
+    Pass,
+    /// Different.
+    Fail,
+    /// Outside the method's limits (or the method does not apply): not compared.
+    Skip(&'static str),
+}
+
+/// Compares a method's outcome with the case's expectation (see the [module docs](self)).
+#[must_use]
+pub fn compare(method: Method, case: &Case, got: &Outcome) -> Verdict {
+    if let Limit::Outside(why) = method.limits(case) {
+        return Verdict::Skip(why);
+    }
+    if !got.applicable {
+        return Verdict::Skip("method does not apply to this kind");
+    }
+    if matches(case, &got.values) {
+        Verdict::Pass
+    } else {
+        Verdict::Fail
+    }
+}
+
+/// True when `got` has the expected hit/miss and values within tolerance (ignoring limits).
+#[must_use]
+pub fn matches(case: &Case, got: &Values) -> bool {
+    let (e, g) = (case.expect, *got);
+    if e.n != g.n {
+        return false;
+    }
+    for k in 0..e.n as usize {
+        let (x, y) = (e.v[k] as f64, g.v[k] as f64);
+        let barycentric = case.kind == Kind::Triangle && k > 0;
+        let ok = if barycentric {
+            (x - y).abs() <= UV_TOLERANCE
+        } else {
+            (x - y).abs() <= T_TOLERANCE * x.abs()
+        };
+        if !ok {
+            return false;
+        }
+    }
+    true
+}
+
+/// FNV-1a (64-bit) over results in order: for each case its applicability, the number of
+/// values and the bit pattern of every value. Equal digests mean bit-identical results.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Digest(u64);
+
+impl Default for Digest {
+    fn default() -> Self {
+        Digest(0xcbf2_9ce4_8422_2325)
+    }
+}
+
+impl Digest {
+    /// An empty digest.
+    #[must_use]
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    fn byte(&mut self, b: u8) {
+        self.0 = (self.0 ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
+    }
+
+    /// Adds one outcome.
+    pub fn update(&mut self, o: &Outcome) {
+        self.byte(o.applicable as u8);
+        self.byte(o.values.n);
+        for x in o.values.as_slice() {
+            for b in x.to_bits().to_le_bytes() {
+                self.byte(b);
+            }
+        }
+    }
+
+    /// The digest value.
+    #[must_use]
+    pub fn value(&self) -> u64 {
+        self.0
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_each_kind() {
+        let c = parse_line(
+            "sphere 1 0 1  0.40824829 0.81649658 0.40824829  5 5 5 3 -> 4.8989797 9.797959",
+            3,
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!((c.kind, c.expect.n, c.line), (Kind::Sphere, 2, 3));
+        assert_eq!(parse_line("  # comment", 1), None);
+        assert_eq!(
+            parse_line("plane 0 0 0 1 0 0 2 0 0 1 0 0 -> 2", 1)
+                .unwrap()
+                .unwrap()
+                .expect
+                .v[0],
+            2.0
+        );
+        assert_eq!(
+            parse_line("triangle 0 0 0 0 0 1 0 0 1 1 0 1 0 1 1 -> miss", 1)
+                .unwrap()
+                .unwrap()
+                .expect,
+            Values::MISS
+        );
+        assert_eq!(
+            parse_line("plane 0 0 -> 1", 1),
+            Some(Err(ParseError::InputCount))
+        );
+        assert_eq!(
+            parse_line("cone 0 -> 1", 1),
+            Some(Err(ParseError::UnknownKind))
+        );
+        assert_eq!(
+            parse_line("plane 0 0 0 1 0 0 2 0 0 1 0 0 -> 1 2", 1),
+            Some(Err(ParseError::Expectation))
+        );
+        let nan = parse_line("sphere NaN 0 0 1 0 0 inf 0 0 -1 -> miss", 1)
+            .unwrap()
+            .unwrap();
+        assert!(nan.input[0].is_nan() && nan.input[6].is_infinite());
+    }
+}
