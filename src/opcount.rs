@@ -244,3 +244,132 @@ mod tests {
         assert_eq!(c, OpCounts::new(1, 2, 1, 1, 1));
     }
 }
+
+/// One row of the operation-count report.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Row {
+    /// Kernel name.
+    pub kernel: &'static str,
+    /// `miss`, `hit`, or a named path (e.g. `doubtful`).
+    pub path: &'static str,
+    /// What one test of one lane performed.
+    pub counts: OpCounts,
+}
+
+/// The report: every kernel on a miss and on a hit, measured with `Counted<f32>` on the
+/// lectures' worked examples (sphere centre (5,5,5), radius 3; the miss ray from the origin
+/// along (1,3,4)/√26, the hit ray from (1,0,1) along (1,2,1)/√6).
+#[must_use]
+pub fn table() -> [Row; 21] {
+    use crate::plane::{self, FocalPlane, Plane, PlanePacket};
+    use crate::ray::{Ray, RayPacket};
+    use crate::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
+    use crate::sphere::{self as sp, FocalSphere, Geometric, SphereKernel, SpherePacket};
+    use glam::Vec3;
+
+    type C = Counted<f32>;
+    let ball = sp::Sphere::new(Vec3::splat(5.0), 3.0);
+    let miss = Ray::new(Vec3::ZERO, Vec3::new(1.0, 3.0, 4.0).normalize());
+    let hit = Ray::new(
+        Vec3::new(1.0, 0.0, 1.0),
+        Vec3::new(1.0, 2.0, 1.0).normalize(),
+    );
+    // A ray grazing the rim of a sphere 2^16 radii away: the guard cannot decide it.
+    let far = sp::Sphere::new(Vec3::new(65536.0, 1.0, 0.0), 1.0);
+    let graze = Ray::new(Vec3::ZERO, Vec3::X);
+
+    fn count<K: SphereKernel>(r: &Ray, s: &sp::Sphere) -> OpCounts {
+        let (rp, sp) = (RayPacket::<C>::splat(r), SpherePacket::<C>::splat(s));
+        measure(|| K::roots(&rp, &sp)).1
+    }
+    fn focal<K: FocalKernel>(r: &Ray, e: &FocalSphere<f32>) -> OpCounts {
+        let (rp, ep) = (RayPacket::<C>::splat(r), FocalSphere::<C>::splat(e));
+        measure(|| K::roots(&rp, &ep)).1
+    }
+    let prepared = |r: &Ray| {
+        let rp = RayPacket::<C>::splat(r);
+        let p = Geometric::prepare(rp.origin(), &SpherePacket::splat(&ball));
+        measure(|| Geometric::roots_prepared(&rp, &p)).1
+    };
+    let surface = |r: &Ray, t: f32, with: bool| {
+        let rp = RayPacket::<C>::splat(r);
+        let s = SpherePacket::<C>::splat(&ball);
+        let tc = Counted(t);
+        measure(|| {
+            if with {
+                let _ = sp::surface(&rp, &s, tc);
+            } else {
+                let _ = rp.origin().mul_add(rp.dir(), tc);
+            }
+        })
+        .1
+    };
+    let wall = Plane::new(Vec3::new(2.0, 0.0, 0.0), Vec3::X);
+    let behind = Plane::new(Vec3::new(-2.0, 0.0, 0.0), Vec3::X);
+    let plane_count = |p: &Plane, focal: bool| {
+        let rp = RayPacket::<C>::splat(&Ray::new(Vec3::ZERO, Vec3::X));
+        if focal {
+            let f = FocalPlane::new(Vec3::ZERO, p);
+            measure(|| f.intersect_lanes(&rp)).1
+        } else {
+            let pp = PlanePacket::<C>::splat(p);
+            measure(|| plane::intersect_lanes(&rp, &pp)).1
+        }
+    };
+    let row = |kernel, path, counts| Row {
+        kernel,
+        path,
+        counts,
+    };
+    [
+        row("quadratic", "miss", count::<sp::Quadratic>(&miss, &ball)),
+        row("quadratic", "hit", count::<sp::Quadratic>(&hit, &ball)),
+        row(
+            "quadratic-unit",
+            "miss",
+            count::<sp::QuadraticUnit>(&miss, &ball),
+        ),
+        row(
+            "quadratic-unit",
+            "hit",
+            count::<sp::QuadraticUnit>(&hit, &ball),
+        ),
+        row("geometric", "miss", count::<Geometric>(&miss, &ball)),
+        row("geometric", "hit", count::<Geometric>(&hit, &ball)),
+        row("geometric-prepared", "miss", prepared(&miss)),
+        row("geometric-prepared", "hit", prepared(&hit)),
+        row("robust", "miss", count::<sp::Robust>(&miss, &ball)),
+        row("robust", "hit", count::<sp::Robust>(&hit, &ball)),
+        row(
+            "focal",
+            "miss",
+            focal::<Focal>(&miss, &FocalSphere::new(miss.origin(), &ball)),
+        ),
+        row(
+            "focal",
+            "hit",
+            focal::<Focal>(&hit, &FocalSphere::new(hit.origin(), &ball)),
+        ),
+        row(
+            "focal",
+            "doubtful",
+            focal::<Focal>(&graze, &FocalSphere::new(Vec3::ZERO, &far)),
+        ),
+        row(
+            "focal-unguarded",
+            "miss",
+            focal::<FocalUnguarded>(&miss, &FocalSphere::unguarded(miss.origin(), &ball)),
+        ),
+        row(
+            "focal-unguarded",
+            "hit",
+            focal::<FocalUnguarded>(&hit, &FocalSphere::unguarded(hit.origin(), &ball)),
+        ),
+        row("sphere-point", "hit", surface(&hit, 4.898979, false)),
+        row("sphere-surface", "hit", surface(&hit, 4.898979, true)),
+        row("plane", "miss", plane_count(&behind, false)),
+        row("plane", "hit", plane_count(&wall, false)),
+        row("plane-focal", "miss", plane_count(&behind, true)),
+        row("plane-focal", "hit", plane_count(&wall, true)),
+    ]
+}

@@ -82,6 +82,8 @@ pub struct FocalSphere<L: Lane> {
     l2_hit: L,
     /// Certain miss when `l² ≥ l2_miss`.
     l2_miss: L,
+    /// A certain hit's roots are accurate when both have magnitude at least `t_acc`.
+    t_acc: L,
     /// The sphere, for the `f64` fallback.
     center: V3<L>,
     radius: L,
@@ -130,25 +132,36 @@ impl FocalSphere<f32> {
         let k = c2 - r2e;
         let t = V3::new(te[0] as f32, te[1] as f32, te[2] as f32);
         let r2 = (r2e as f32).max(0.0);
-        let entry = |k_lo: f32, l2_hit: f32, l2_miss: f32| FocalSphere {
+        let entry = |k_lo: f32, l2_hit: f32, l2_miss: f32, t_acc: f32| FocalSphere {
             t,
             k_lo,
             r2,
             l2_hit,
             l2_miss,
+            t_acc,
             center: center.into(),
             radius,
         };
         if !(sphere.is_valid() && eye.is_finite()) {
-            return entry(f32::INFINITY, f32::NEG_INFINITY, f32::INFINITY);
+            return entry(
+                f32::INFINITY,
+                f32::NEG_INFINITY,
+                f32::INFINITY,
+                f32::INFINITY,
+            );
         }
         if !guarded {
-            return entry(k as f32, f32::NEG_INFINITY, f32::INFINITY);
+            return entry(k as f32, f32::NEG_INFINITY, f32::INFINITY, f32::INFINITY);
         }
         let c = libm::sqrt(c2);
         if !(c <= 1.0e18 && (1.0e-12..=1.0e18).contains(&r)) {
             // Squares would leave f32's range: every ray takes the f64 path.
-            return entry(f32::NEG_INFINITY, f32::NEG_INFINITY, f32::INFINITY);
+            return entry(
+                f32::NEG_INFINITY,
+                f32::NEG_INFINITY,
+                f32::INFINITY,
+                f32::INFINITY,
+            );
         }
         let n1 = 1.0 + ETA;
         // Step 1. |v_c − v| ≤ dv (T rounded once, three products, two sums), and the bound E₁ on
@@ -170,19 +183,19 @@ impl FocalSphere<f32> {
         } else {
             -1.0
         };
-        // Step 3. Accuracy of t = v ∓ √(r² − l²) on a certain hit: |t_c − t| ≤ α + E_X/√X + (2u+η)(c+r),
-        // with E_X the error of X = r² − l²; require ≤ 2^-17·t_low, t_low ≤ |t| for both roots.
+        // Step 3. Accuracy of t = v ∓ √(r² − l²) on a certain hit. Accept only X = r² − l² ≥ r²/16
+        // (l² ≤ l2_acc), so √X ≥ r/4 and |t_c − t| ≤ err = α + 4·E_X/r + (2u+η)(c+r), with E_X
+        // the error of X. A root is then within 2^-17 of the exact one when |t_c| ≥ t_acc =
+        // err/2^-17 + err: one compare per root, per lane.
         let a = libm::sqrt(a2);
         let wp = w0 + 1.01 * U * (r + a + w0);
         let e_l2 = a2 + 2.0 * wp * (r + a) + wp * wp + g3 * sq(r + a + wp);
         let e_x = 1.01 * e_l2 + 2.01 * U * r2e;
-        let t_low = k.abs() / (2.0 * (c + r));
-        let budget = EPS_T * t_low - alpha - 1.01 * (2.0 * U + ETA) * (c + r) * n1;
-        let l2_acc = if budget > 0.0 {
-            r2e * (1.0 - U) - sq(e_x / budget) - e_x
-        } else {
-            -1.0
-        };
+        let x_min = r2e / 16.0;
+        let l2_acc = r2e * (1.0 - U) - x_min - e_x;
+        let err = (alpha + e_x / libm::sqrt(x_min) + 1.01 * (2.0 * U + ETA) * (c + r) * n1)
+            * (1.0 + F64_REL);
+        let t_acc = up(err / EPS_T + err);
         let l2_hit = l2_sure.min(l2_acc);
         entry(
             k_lo,
@@ -192,6 +205,7 @@ impl FocalSphere<f32> {
                 f32::NEG_INFINITY
             },
             l2_miss,
+            t_acc,
         )
     }
 }
@@ -207,6 +221,7 @@ impl<L: Lane> FocalSphere<L> {
             r2: L::from_f32(e.r2),
             l2_hit: L::from_f32(e.l2_hit),
             l2_miss: L::from_f32(e.l2_miss),
+            t_acc: L::from_f32(e.t_acc),
             center: V3::splat(e.center.into()),
             radius: L::from_f32(e.radius),
         }
@@ -223,6 +238,7 @@ impl<L: Lane> FocalSphere<L> {
             r2: L::from_f32_fn(|i| get(i).r2),
             l2_hit: L::from_f32_fn(|i| get(i).l2_hit),
             l2_miss: L::from_f32_fn(|i| get(i).l2_miss),
+            t_acc: L::from_f32_fn(|i| get(i).t_acc),
             center: V3::from_fn(|i| get(i).center.into()),
             radius: L::from_f32_fn(|i| get(i).radius),
         }
@@ -312,11 +328,13 @@ fn focal<L: Lane, const GUARDED: bool>(ray: &RayPacket<L>, s: &FocalSphere<L>) -
     }
     // 2. Perpendicular from the centre to the ray: p = T − vU, l² = p·p.
     let l2 = (s.t - ray.dir.scale(v)).length_squared();
-    let sure_hit = maybe & l2.le(s.l2_hit);
     let sure_miss = l2.ge(s.l2_miss);
-    // 3. Half chord and both roots of the certain hits.
+    // 3. Half chord and both roots; a certain hit needs l² ≤ l2_hit and both roots far enough
+    //    from zero for their error bound to be within 2^-17 of them.
     let d = (s.r2 - l2).sqrt();
-    let roots = Roots::in_interval(ray, v - d, v + d, sure_hit);
+    let (t0, t1) = (v - d, v + d);
+    let sure_hit = maybe & l2.le(s.l2_hit) & t0.abs().ge(s.t_acc) & t1.abs().ge(s.t_acc);
+    let roots = Roots::in_interval(ray, t0, t1, sure_hit);
     // 4. Lanes the guard cannot decide: the robust body in f64, one lane at a time.
     let doubtful = maybe.and_not(sure_hit | sure_miss);
     if doubtful.none() {
