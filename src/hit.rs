@@ -141,20 +141,23 @@ impl Hit<f32> {
 /// Closest hit of ray lanes over primitives tested one at a time (N rays × 1 primitive).
 ///
 /// `test` sees the rays with `t_max` already shrunk to the closest hit so far, so it reports
-/// only closer hits.
+/// only closer hits; it returns `None` when no lane can hit (a kernel's early exit), which lets
+/// the miss path skip the merge with the hit path entirely.
 #[inline]
 pub fn closest<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: impl IntoIterator<Item = P>,
-    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
 ) -> Hit<L> {
     let mut r = *rays;
     let mut best = Hit::none();
     for (i, p) in prims.into_iter().enumerate() {
-        let h = test(&r, p);
-        if h.mask.any() {
-            best.update(&h, i as u32);
-            r = r.shrink(h.mask, h.t);
+        // `None`: no lane passed the kernel's first test (nothing to merge on the miss path).
+        if let Some(h) = test(&r, p) {
+            if h.mask.any() {
+                best.update(&h, i as u32);
+                r = r.shrink(h.mask, h.t);
+            }
         }
     }
     best
@@ -165,14 +168,78 @@ pub fn closest<L: Lane, P>(
 pub fn any<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: impl IntoIterator<Item = P>,
-    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
 ) -> L::Mask {
     let valid = rays.valid();
     let mut hit = L::Mask::splat(false);
     for p in prims {
-        hit = hit | test(rays, p).mask;
+        if let Some(h) = test(rays, p) {
+            hit = hit | h.mask;
+        }
         if valid.and_not(hit).none() {
             break;
+        }
+    }
+    hit & valid
+}
+
+/// [`closest`] in two passes per block of 64 primitives: `candidate` (a kernel's cheap first
+/// step, with no calls, so the rays stay in registers) marks the primitives some lane may hit,
+/// then `test` runs on those alone, in order. Same result as [`closest`] with `test`, provided
+/// `test` returns `None` wherever `candidate` is false and `candidate` does not depend on
+/// `t_max`.
+#[inline]
+pub fn closest_filtered<L: Lane, P>(
+    rays: &RayPacket<L>,
+    prims: &[P],
+    mut candidate: impl FnMut(&RayPacket<L>, &P) -> bool,
+    mut test: impl FnMut(&RayPacket<L>, &P) -> Option<LaneHit<L>>,
+) -> Hit<L> {
+    let mut r = *rays;
+    let mut best = Hit::none();
+    for (b, block) in prims.chunks(64).enumerate() {
+        let mut bits = 0u64;
+        for (j, p) in block.iter().enumerate() {
+            bits |= (candidate(&r, p) as u64) << j;
+        }
+        while bits != 0 {
+            let j = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            if let Some(h) = test(&r, &block[j]) {
+                if h.mask.any() {
+                    best.update(&h, (b * 64 + j) as u32);
+                    r = r.shrink(h.mask, h.t);
+                }
+            }
+        }
+    }
+    best
+}
+
+/// [`any`] in two passes per block of 64 primitives, as [`closest_filtered`].
+#[inline]
+pub fn any_filtered<L: Lane, P>(
+    rays: &RayPacket<L>,
+    prims: &[P],
+    mut candidate: impl FnMut(&RayPacket<L>, &P) -> bool,
+    mut test: impl FnMut(&RayPacket<L>, &P) -> Option<LaneHit<L>>,
+) -> L::Mask {
+    let valid = rays.valid();
+    let mut hit = L::Mask::splat(false);
+    for block in prims.chunks(64) {
+        let mut bits = 0u64;
+        for (j, p) in block.iter().enumerate() {
+            bits |= (candidate(rays, p) as u64) << j;
+        }
+        while bits != 0 {
+            let j = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            if let Some(h) = test(rays, &block[j]) {
+                hit = hit | h.mask;
+                if valid.and_not(hit).none() {
+                    return hit & valid;
+                }
+            }
         }
     }
     hit & valid
@@ -187,7 +254,7 @@ pub fn any<L: Lane, P>(
 pub fn closest_soa<L: Lane, P>(
     ray: &Ray,
     chunks: impl IntoIterator<Item = P>,
-    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
 ) -> Option<HitRecord>
 where
     L::Scalar: Scalar,
@@ -195,7 +262,7 @@ where
     let mut r = RayPacket::<L>::splat(ray);
     let mut best = Hit::<L>::none();
     for (c, p) in chunks.into_iter().enumerate() {
-        let h = test(&r, p);
+        let Some(h) = test(&r, p) else { continue };
         if h.mask.any() {
             let mut bits = h.mask.bits();
             while bits != 0 {
@@ -235,8 +302,10 @@ where
 pub fn any_soa<L: Lane, P>(
     ray: &Ray,
     chunks: impl IntoIterator<Item = P>,
-    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
 ) -> bool {
     let r = RayPacket::<L>::splat(ray);
-    chunks.into_iter().any(|p| test(&r, p).mask.any())
+    chunks
+        .into_iter()
+        .any(|p| test(&r, p).is_some_and(|h| h.mask.any()))
 }

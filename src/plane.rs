@@ -153,7 +153,7 @@ pub fn intersect(ray: &Ray, plane: &Plane) -> Option<HitRecord> {
 #[must_use]
 pub fn closest<L: Lane>(rays: &RayPacket<L>, planes: &[Plane]) -> hit::Hit<L> {
     hit::closest(rays, planes, |r, p| {
-        intersect_lanes(r, &PlanePacket::splat(p))
+        Some(intersect_lanes(r, &PlanePacket::splat(p)))
     })
 }
 
@@ -162,7 +162,7 @@ pub fn closest<L: Lane>(rays: &RayPacket<L>, planes: &[Plane]) -> hit::Hit<L> {
 #[must_use]
 pub fn any<L: Lane>(rays: &RayPacket<L>, planes: &[Plane]) -> L::Mask {
     hit::any(rays, planes, |r, p| {
-        intersect_lanes(r, &PlanePacket::splat(p))
+        Some(intersect_lanes(r, &PlanePacket::splat(p)))
     })
 }
 
@@ -181,12 +181,12 @@ pub fn all<L: Lane>(rays: &RayPacket<L>, planes: &[Plane], mut f: impl FnMut(u32
 #[inline]
 #[must_use]
 pub fn closest_focal<L: Lane>(rays: &RayPacket<L>, cache: &[FocalPlane]) -> hit::Hit<L> {
-    hit::closest(rays, cache, |r, p| p.intersect_lanes(r))
+    hit::closest(rays, cache, |r, p| Some(p.intersect_lanes(r)))
 }
 
 /// Closest hit of one ray over planes packed in lanes (1 ray × N planes).
 #[inline]
 #[must_use]
 pub fn closest_soa<L: Lane>(ray: &Ray, planes: &[PlanePacket<L>]) -> Option<HitRecord> {
-    hit::closest_soa(ray, planes, |r, p| intersect_lanes(r, p))
+    hit::closest_soa(ray, planes, |r, p| Some(intersect_lanes(r, p)))
 }

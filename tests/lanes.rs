@@ -54,11 +54,22 @@ fn sphere(rng: &mut SmallRng) -> Sphere {
 }
 
 fn same_roots<L: Lane<Scalar = f32>>(p: &Roots<L>, i: usize, s: &Roots<f32>, what: &str) {
-    assert_eq!(p.t0.lane(i).to_bits(), s.t0.to_bits(), "{what}: t0 lane {i}");
-    assert_eq!(p.t1.lane(i).to_bits(), s.t1.to_bits(), "{what}: t1 lane {i}");
+    assert_eq!(
+        p.t0.lane(i).to_bits(),
+        s.t0.to_bits(),
+        "{what}: t0 lane {i}"
+    );
+    assert_eq!(
+        p.t1.lane(i).to_bits(),
+        s.t1.to_bits(),
+        "{what}: t1 lane {i}"
+    );
     assert_eq!(p.m0.test(i), s.m0, "{what}: m0 lane {i}");
     assert_eq!(p.m1.test(i), s.m1, "{what}: m1 lane {i}");
-    assert!(!p.t0.lane(i).is_nan() && !p.t1.lane(i).is_nan(), "{what}: NaN in a record");
+    assert!(
+        !p.t0.lane(i).is_nan() && !p.t1.lane(i).is_nan(),
+        "{what}: NaN in a record"
+    );
 }
 
 fn kernel<K: SphereKernel, L: Lane<Scalar = f32>>(rays: &[Ray], spheres: &[Sphere]) {
@@ -66,19 +77,36 @@ fn kernel<K: SphereKernel, L: Lane<Scalar = f32>>(rays: &[Ray], spheres: &[Spher
     let sp = SpherePacket::<L>::from_spheres(spheres);
     let packed = K::roots(&rp, &sp);
     for i in 0..L::LANES {
-        let (r, s) = (rp.ray(i), spheres.get(i).copied().unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN)));
+        let (r, s) = (
+            rp.ray(i),
+            spheres
+                .get(i)
+                .copied()
+                .unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN)),
+        );
         let scalar = K::roots(&RayPacket::<f32>::splat(&r), &SpherePacket::splat(&s));
         same_roots(&packed, i, &scalar, K::NAME);
     }
 }
 
-fn focal_kernel<K: FocalKernel, L: Lane<Scalar = f32>>(rays: &[Ray], spheres: &[Sphere], guarded: bool) {
+fn focal_kernel<K: FocalKernel, L: Lane<Scalar = f32>>(
+    rays: &[Ray],
+    spheres: &[Sphere],
+    guarded: bool,
+) {
     let rp = RayPacket::<L>::from_rays(rays);
     let entries: Vec<FocalSphere<f32>> = (0..L::LANES)
         .map(|i| {
-            let s = spheres.get(i).copied().unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN));
+            let s = spheres
+                .get(i)
+                .copied()
+                .unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN));
             let eye = rp.ray(i).origin();
-            if guarded { FocalSphere::new(eye, &s) } else { FocalSphere::unguarded(eye, &s) }
+            if guarded {
+                FocalSphere::new(eye, &s)
+            } else {
+                FocalSphere::unguarded(eye, &s)
+            }
         })
         .collect();
     let packed = K::roots(&rp, &FocalSphere::<L>::gather(&entries));
@@ -92,15 +120,26 @@ fn planes<L: Lane<Scalar = f32>>(rays: &[Ray], ps: &[Plane]) {
     let rp = RayPacket::<L>::from_rays(rays);
     let pp = PlanePacket::<L>::from_planes(ps);
     let packed = plane::intersect_lanes(&rp, &pp);
-    let nums = L::from_f32_fn(|i| FocalPlane::new(rp.ray(i).origin(), &ps[i.min(ps.len() - 1)]).num());
+    let nums =
+        L::from_f32_fn(|i| FocalPlane::new(rp.ray(i).origin(), &ps[i.min(ps.len() - 1)]).num());
     let focal = plane::focal_lanes(&rp, nums, V3::from_fn(|i| ps[i.min(ps.len() - 1)].normal));
     for i in 0..L::LANES {
-        let p = ps.get(i).copied().unwrap_or(Plane::new(Vec3::ZERO, Vec3::ZERO));
-        let s = plane::intersect_lanes(&RayPacket::<f32>::splat(&rp.ray(i)), &PlanePacket::splat(&p));
+        let p = ps
+            .get(i)
+            .copied()
+            .unwrap_or(Plane::new(Vec3::ZERO, Vec3::ZERO));
+        let s = plane::intersect_lanes(
+            &RayPacket::<f32>::splat(&rp.ray(i)),
+            &PlanePacket::splat(&p),
+        );
         assert_eq!(packed.t.lane(i).to_bits(), s.t.to_bits(), "plane lane {i}");
         assert_eq!(packed.mask.test(i), s.mask);
         if i < ps.len() {
-            assert_eq!(focal.t.lane(i).to_bits(), s.t.to_bits(), "plane-focal equals plane, lane {i}");
+            assert_eq!(
+                focal.t.lane(i).to_bits(),
+                s.t.to_bits(),
+                "plane-focal equals plane, lane {i}"
+            );
         }
     }
 }
@@ -111,14 +150,21 @@ fn every_kernel<L: Lane<Scalar = f32>>(seed: u64) {
         let spheres: Vec<Sphere> = (0..L::LANES).map(|_| sphere(&mut rng)).collect();
         let rays: Vec<Ray> = spheres.iter().map(|s| ray(&mut rng, s.center())).collect();
         // Sometimes fewer rays than lanes: the padding lanes must miss.
-        let n = if rng.random_range(0..8) == 0 { rng.random_range(0..L::LANES) } else { L::LANES };
+        let n = if rng.random_range(0..8) == 0 {
+            rng.random_range(0..L::LANES)
+        } else {
+            L::LANES
+        };
         kernel::<Quadratic, L>(&rays[..n], &spheres);
         kernel::<QuadraticUnit, L>(&rays[..n], &spheres);
         kernel::<Geometric, L>(&rays[..n], &spheres);
         kernel::<Robust, L>(&rays[..n], &spheres);
         focal_kernel::<Focal, L>(&rays[..n], &spheres, true);
         focal_kernel::<FocalUnguarded, L>(&rays[..n], &spheres, false);
-        let ps: Vec<Plane> = spheres.iter().map(|s| Plane::new(s.center(), vec(&mut rng, 1.0))).collect();
+        let ps: Vec<Plane> = spheres
+            .iter()
+            .map(|s| Plane::new(s.center(), vec(&mut rng, 1.0)))
+            .collect();
         planes::<L>(&rays, &ps);
     }
 }
@@ -143,13 +189,27 @@ fn far_rim<L: Lane<Scalar = f32>>(seed: u64) {
     let mut rng = SmallRng::seed_from_u64(seed);
     for k in 6..=20 {
         for _ in 0..40 {
-            let eye = Vec3::new(rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0), 0.0);
+            let eye = Vec3::new(
+                rng.random_range(-5.0..5.0),
+                rng.random_range(-5.0..5.0),
+                0.0,
+            );
             let r = rng.random_range(0.1..2.0f32);
             let dist = r * (1u32 << k) as f32;
-            let dir = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), 1.0).normalize();
+            let dir = Vec3::new(
+                rng.random_range(-1.0..1.0),
+                rng.random_range(-1.0..1.0),
+                1.0,
+            )
+            .normalize();
             let side = dir.any_orthonormal_vector();
             let spheres: Vec<Sphere> = (0..L::LANES)
-                .map(|_| Sphere::new(eye + dir * dist + side * r * rng.random_range(0.9..1.1f32), r))
+                .map(|_| {
+                    Sphere::new(
+                        eye + dir * dist + side * r * rng.random_range(0.9..1.1f32),
+                        r,
+                    )
+                })
                 .collect();
             let rays: Vec<Ray> = (0..L::LANES).map(|_| Ray::new(eye, dir)).collect();
             focal_kernel::<Focal, L>(&rays, &spheres, true);
@@ -176,7 +236,9 @@ fn entry_points<L: Lane<Scalar = f32>>(seed: u64) {
     let mut rng = SmallRng::seed_from_u64(seed);
     for _ in 0..60 {
         let spheres: Vec<Sphere> = (0..23).map(|_| sphere(&mut rng)).collect();
-        let rays: Vec<Ray> = (0..L::LANES).map(|i| ray(&mut rng, spheres[i].center())).collect();
+        let rays: Vec<Ray> = (0..L::LANES)
+            .map(|i| ray(&mut rng, spheres[i].center()))
+            .collect();
         let rp = RayPacket::<L>::from_rays(&rays);
         let closest = sphere::closest::<Robust, L>(&rp, &spheres);
         let any = sphere::any::<Robust, L>(&rp, &spheres);
@@ -221,7 +283,10 @@ fn entry_points<L: Lane<Scalar = f32>>(seed: u64) {
         focal::focus(eye, &spheres, &mut cache);
         let mut packed = vec![FocalSphere::<L>::gather(&[]); spheres.len().div_ceil(L::LANES)];
         FocalSphere::pack(&cache, &mut packed);
-        let frays: Vec<Ray> = rays.iter().map(|r| Ray::new(eye, r.dir().normalize_or_zero())).collect();
+        let frays: Vec<Ray> = rays
+            .iter()
+            .map(|r| Ray::new(eye, r.dir().normalize_or_zero()))
+            .collect();
         let fp = RayPacket::<L>::from_rays(&frays);
         let fc = focal::closest::<Focal, L>(&fp, &cache);
         let fa = focal::any::<Focal, L>(&fp, &cache);

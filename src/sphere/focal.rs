@@ -19,7 +19,7 @@
 //! precision lecture, reusing `v`: `p = T − vU`, `l² = p·p` (6 mul, 5 add). Subtracting before
 //! squaring keeps the error of `l²` near `4·2^-24·c·r` instead of `9·2^-24·c²`. Two more cached
 //! thresholds, derived from a rounding-error bound, make `l² ≤ l2_hit` a certain hit whose
-//! `t = v ∓ √(r² − l²)` is within `2^-17` relative of the exact root, and `l² ≥ l2_miss` a
+//! `t = v ∓ √(r² − l²)` is within `2^-16` (1.5e-5) relative of the exact root, and `l² ≥ l2_miss` a
 //! certain miss. Only lanes in between — rays grazing the rim within that bound, or spheres so
 //! close to the eye that `t` itself is ill-conditioned — are recomputed with the [`Robust`]
 //! body in `f64` (one lane at a time, then rounded to f32). The result: zero misclassified
@@ -56,7 +56,7 @@ const U: f64 = 1.0 / 16_777_216.0;
 /// Allowed deviation of `|U|²` from 1.
 const ETA: f64 = 1.0 / 1_048_576.0;
 /// Relative accuracy promised for `t` on the f32 hit path.
-const EPS_T: f64 = 1.0 / 131_072.0;
+const EPS_T: f64 = 1.0 / 65_536.0;
 /// Relative error of the f64 cache arithmetic (generous).
 const F64_REL: f64 = 1.0 / 1_125_899_906_842_624.0; // 2^-50
 /// Absolute floor for f32 underflow in products.
@@ -183,18 +183,21 @@ impl FocalSphere<f32> {
         } else {
             -1.0
         };
-        // Step 3. Accuracy of t = v ∓ √(r² − l²) on a certain hit. Accept only X = r² − l² ≥ r²/16
-        // (l² ≤ l2_acc), so √X ≥ r/4 and |t_c − t| ≤ err = α + 4·E_X/r + (2u+η)(c+r), with E_X
-        // the error of X. A root is then within 2^-17 of the exact one when |t_c| ≥ t_acc =
-        // err/2^-17 + err: one compare per root, per lane.
+        // Step 3. Accuracy of t = v ∓ √(r² − l²) on a certain hit: |t_c − t| ≤ err = rest + E_X/√X,
+        // with rest = α + (2u+η)(c+r) and E_X the error of X = r² − l². Every root of a ray from
+        // outside has |t| ≥ c − r, so aim for err = 2^-16·|c − r|/2 (at least 2·rest) and accept
+        // only X ≥ X_min = (E_X/(err − rest))² (l² ≤ l2_acc). A root is then within 2^-16 of the
+        // exact one when |t_c| ≥ t_acc = err/2^-16 + err — true for every root of a ray from
+        // outside; one compare per root, per lane, catches the rest.
         let a = libm::sqrt(a2);
         let wp = w0 + 1.01 * U * (r + a + w0);
         let e_l2 = a2 + 2.0 * wp * (r + a) + wp * wp + g3 * sq(r + a + wp);
         let e_x = 1.01 * e_l2 + 2.01 * U * r2e;
-        let x_min = r2e / 16.0;
+        let rest = alpha + 1.01 * (2.0 * U + ETA) * (c + r) * n1;
+        let err = (0.5 * EPS_T * (c - r).abs()).max(2.0 * rest);
+        let x_min = sq(e_x / (err - rest));
         let l2_acc = r2e * (1.0 - U) - x_min - e_x;
-        let err = (alpha + e_x / libm::sqrt(x_min) + 1.01 * (2.0 * U + ETA) * (c + r) * n1)
-            * (1.0 + F64_REL);
+        let err = err * (1.0 + F64_REL);
         let t_acc = up(err / EPS_T + err);
         let l2_hit = l2_sure.min(l2_acc);
         entry(
@@ -265,6 +268,52 @@ impl<L: Lane> FocalSphere<L> {
     }
 }
 
+/// Where a focal kernel reads its cached sphere lanes from: a [`FocalSphere<L>`] already in
+/// lanes (1 ray × N spheres), or a [`Splat`] of one entry (N rays × 1 sphere) that broadcasts
+/// only what each step needs, so a miss touches `T` and `k_lo` alone.
+pub trait FocalLanes<L: Lane> {
+    /// `T = C − E` in lanes.
+    fn t(&self) -> V3<L>;
+    /// The cheap test's threshold in lanes.
+    fn k_lo(&self) -> L;
+    /// Every field in lanes (for the hit path).
+    fn lanes(&self) -> FocalSphere<L>;
+}
+
+impl<L: Lane> FocalLanes<L> for FocalSphere<L> {
+    #[inline(always)]
+    fn t(&self) -> V3<L> {
+        self.t
+    }
+    #[inline(always)]
+    fn k_lo(&self) -> L {
+        self.k_lo
+    }
+    #[inline(always)]
+    fn lanes(&self) -> FocalSphere<L> {
+        *self
+    }
+}
+
+/// One cache entry seen in every lane, broadcast lazily (see [`FocalLanes`]).
+#[derive(Clone, Copy, Debug)]
+pub struct Splat<'a>(pub &'a FocalSphere<f32>);
+
+impl<L: Lane> FocalLanes<L> for Splat<'_> {
+    #[inline(always)]
+    fn t(&self) -> V3<L> {
+        V3::splat(self.0.t.into())
+    }
+    #[inline(always)]
+    fn k_lo(&self) -> L {
+        L::from_f32(self.0.k_lo)
+    }
+    #[inline(always)]
+    fn lanes(&self) -> FocalSphere<L> {
+        FocalSphere::splat(self.0)
+    }
+}
+
 /// Builds the guarded cache of `spheres` for rays from `eye` into `out` (no allocation);
 /// returns the number of entries written (`min(spheres.len(), out.len())`).
 pub fn focus(eye: Vec3, spheres: &[Sphere], out: &mut [FocalSphere<f32>]) -> usize {
@@ -282,7 +331,17 @@ pub trait FocalKernel {
     const NAME: &'static str;
     /// All roots of ray lanes (starting at the cache's eye, unit directions) against the cached
     /// sphere in each lane, ascending, inside the ray's interval.
-    fn roots<L: Lane>(ray: &RayPacket<L>, s: &FocalSphere<L>) -> Roots<L>;
+    fn roots<L: Lane, S: FocalLanes<L>>(ray: &RayPacket<L>, s: &S) -> Roots<L> {
+        Self::maybe_roots(ray, s).unwrap_or_else(Roots::miss)
+    }
+    /// The same, or `None` when no lane passes the cheap test (every lane misses).
+    fn maybe_roots<L: Lane, S: FocalLanes<L>>(ray: &RayPacket<L>, s: &S) -> Option<Roots<L>>;
+    /// True when some lane passes the cheap test (step 1 alone): the first pass of the
+    /// closest/any loops, which then run the whole test only for these spheres.
+    #[inline(always)]
+    fn candidate<L: Lane, S: FocalLanes<L>>(ray: &RayPacket<L>, s: &S) -> bool {
+        cheap(ray, s).2.any()
+    }
 }
 
 /// The guarded focal test (the default; see the [module docs](self)).
@@ -299,38 +358,55 @@ pub struct FocalUnguarded;
 impl FocalKernel for Focal {
     const NAME: &'static str = "focal";
     #[inline(always)]
-    fn roots<L: Lane>(ray: &RayPacket<L>, s: &FocalSphere<L>) -> Roots<L> {
-        focal::<L, true>(ray, s)
+    fn maybe_roots<L: Lane, S: FocalLanes<L>>(ray: &RayPacket<L>, s: &S) -> Option<Roots<L>> {
+        focal::<L, S, true>(ray, s)
     }
 }
 
 impl FocalKernel for FocalUnguarded {
     const NAME: &'static str = "focal-unguarded";
     #[inline(always)]
-    fn roots<L: Lane>(ray: &RayPacket<L>, s: &FocalSphere<L>) -> Roots<L> {
-        focal::<L, false>(ray, s)
+    fn maybe_roots<L: Lane, S: FocalLanes<L>>(ray: &RayPacket<L>, s: &S) -> Option<Roots<L>> {
+        focal::<L, S, false>(ray, s)
     }
+}
+
+/// Step 1 of both tests: `v = T·U`, `v²`, and the lanes with `v² > k_lo` (4 mul, 2 add, 1 cmp).
+#[inline(always)]
+fn cheap<L: Lane, S: FocalLanes<L>>(ray: &RayPacket<L>, s: &S) -> (L, L, L::Mask) {
+    let v = s.t().dot(ray.dir);
+    let v2 = v * v;
+    (v, v2, v2.gt(s.k_lo()))
 }
 
 /// One body for both; `GUARDED` selects the perpendicular hit path and the fallback.
 #[inline(always)]
-fn focal<L: Lane, const GUARDED: bool>(ray: &RayPacket<L>, s: &FocalSphere<L>) -> Roots<L> {
+fn focal<L: Lane, S: FocalLanes<L>, const GUARDED: bool>(
+    ray: &RayPacket<L>,
+    s: &S,
+) -> Option<Roots<L>> {
     // 1. Foot of the perpendicular, and the cheap test against the cached threshold.
-    let v = s.t.dot(ray.dir);
-    let v2 = v * v;
-    let maybe = v2.gt(s.k_lo);
+    let (v, v2, maybe) = cheap(ray, s);
+    let k_lo = s.k_lo();
     if maybe.none() {
-        return Roots::miss();
+        return None;
     }
     if !GUARDED {
-        let d = (v2 - s.k_lo).sqrt();
-        return Roots::in_interval(ray, v - d, v + d, maybe);
+        let d = (v2 - k_lo).sqrt();
+        return Some(Roots::in_interval(ray, v - d, v + d, maybe));
     }
+    // 2.–4. Reading the rest of the entry only now.
+    Some(hit_path(ray, &s.lanes(), v, maybe))
+}
+
+/// Steps 2–4 of the guarded test, for lanes that passed the cheap test (`maybe`).
+#[inline(always)]
+fn hit_path<L: Lane>(ray: &RayPacket<L>, s: &FocalSphere<L>, v: L, maybe: L::Mask) -> Roots<L> {
     // 2. Perpendicular from the centre to the ray: p = T − vU, l² = p·p.
     let l2 = (s.t - ray.dir.scale(v)).length_squared();
     let sure_miss = l2.ge(s.l2_miss);
     // 3. Half chord and both roots; a certain hit needs l² ≤ l2_hit and both roots far enough
-    //    from zero for their error bound to be within 2^-17 of them.
+    //    from zero for their error bound to be within 2^-16 of them.
     let d = (s.r2 - l2).sqrt();
     let (t0, t1) = (v - d, v + d);
     let sure_hit = maybe & l2.le(s.l2_hit) & t0.abs().ge(s.t_acc) & t1.abs().ge(s.t_acc);
@@ -369,18 +445,24 @@ pub fn closest<K: FocalKernel, L: Lane>(
     rays: &RayPacket<L>,
     cache: &[FocalSphere<f32>],
 ) -> hit::Hit<L> {
-    hit::closest(rays, cache, |r, e| {
-        K::roots(r, &FocalSphere::splat(e)).first()
-    })
+    hit::closest_filtered(
+        rays,
+        cache,
+        |r, e| K::candidate(r, &Splat(e)),
+        |r, e| K::maybe_roots(r, &Splat(e)).map(|r| r.first()),
+    )
 }
 
 /// Lanes whose ray hits some cached sphere (occlusion).
 #[inline]
 #[must_use]
 pub fn any<K: FocalKernel, L: Lane>(rays: &RayPacket<L>, cache: &[FocalSphere<f32>]) -> L::Mask {
-    hit::any(rays, cache, |r, e| {
-        K::roots(r, &FocalSphere::splat(e)).first()
-    })
+    hit::any_filtered(
+        rays,
+        cache,
+        |r, e| K::candidate(r, &Splat(e)),
+        |r, e| K::maybe_roots(r, &Splat(e)).map(|r| r.first()),
+    )
 }
 
 /// Every root of every cached sphere some lane hits: `f(index, roots)`.
@@ -391,7 +473,7 @@ pub fn all<K: FocalKernel, L: Lane>(
     mut f: impl FnMut(u32, &Roots<L>),
 ) {
     for (i, e) in cache.iter().enumerate() {
-        let r = K::roots(rays, &FocalSphere::splat(e));
+        let r = K::roots(rays, &Splat(e));
         if r.any().any() {
             f(i as u32, &r);
         }
@@ -405,12 +487,12 @@ pub fn closest_soa<K: FocalKernel, L: Lane>(
     ray: &Ray,
     cache: &[FocalSphere<L>],
 ) -> Option<HitRecord> {
-    hit::closest_soa(ray, cache, |r, e| K::roots(r, e).first())
+    hit::closest_soa(ray, cache, |r, e| K::maybe_roots(r, e).map(|r| r.first()))
 }
 
 /// True when one ray from the eye hits some cached sphere packed in lanes.
 #[inline]
 #[must_use]
 pub fn any_soa<K: FocalKernel, L: Lane>(ray: &Ray, cache: &[FocalSphere<L>]) -> bool {
-    hit::any_soa(ray, cache, |r, e| K::roots(r, e).first())
+    hit::any_soa(ray, cache, |r, e| K::maybe_roots(r, e).map(|r| r.first()))
 }

@@ -321,7 +321,7 @@ pub fn intersect<K: SphereKernel>(ray: &Ray, sphere: &Sphere) -> Option<HitRecor
 #[must_use]
 pub fn closest<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) -> hit::Hit<L> {
     hit::closest(rays, spheres, |r, s| {
-        K::roots(r, &SpherePacket::splat(s)).first()
+        Some(K::roots(r, &SpherePacket::splat(s)).first())
     })
 }
 
@@ -330,7 +330,7 @@ pub fn closest<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]
 #[must_use]
 pub fn any<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) -> L::Mask {
     hit::any(rays, spheres, |r, s| {
-        K::roots(r, &SpherePacket::splat(s)).first()
+        Some(K::roots(r, &SpherePacket::splat(s)).first())
     })
 }
 
@@ -357,12 +357,12 @@ pub fn closest_soa<K: SphereKernel, L: Lane>(
     ray: &Ray,
     spheres: &[SpherePacket<L>],
 ) -> Option<HitRecord> {
-    hit::closest_soa(ray, spheres, |r, s| K::roots(r, s).first())
+    hit::closest_soa(ray, spheres, |r, s| Some(K::roots(r, s).first()))
 }
 
 /// True when one ray hits some sphere packed in lanes.
 #[inline]
 #[must_use]
 pub fn any_soa<K: SphereKernel, L: Lane>(ray: &Ray, spheres: &[SpherePacket<L>]) -> bool {
-    hit::any_soa(ray, spheres, |r, s| K::roots(r, s).first())
+    hit::any_soa(ray, spheres, |r, s| Some(K::roots(r, s).first()))
 }

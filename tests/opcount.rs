@@ -1,0 +1,72 @@
+//! The operation counts are measured by the counting lane, and pinned here.
+
+use raylane::opcount::{OpCounts, table};
+
+fn get(kernel: &str, path: &str) -> OpCounts {
+    table()
+        .iter()
+        .find(|r| r.kernel == kernel && r.path == path)
+        .unwrap_or_else(|| panic!("no row {kernel}/{path}"))
+        .counts
+}
+
+/// `OpCounts::new(mul, add, div, sqrt, cmp)`.
+const fn c(mul: u32, add: u32, div: u32, sqrt: u32, cmp: u32) -> OpCounts {
+    OpCounts::new(mul, add, div, sqrt, cmp)
+}
+
+#[test]
+fn brute_force_quadratic_matches_the_lecture() {
+    // Lecture 000: "8 multiplies/squares, 9 additions/subtractions, 1 square root" for the
+    // discriminant μ² − T·T + r² and its root, with unit direction; the two roots μ ± √δ add
+    // the 2 additions the lecture's tally leaves out.
+    let miss = get("quadratic-unit", "miss");
+    let hit = get("quadratic-unit", "hit");
+    assert_eq!(miss, c(8, 9, 0, 0, 1));
+    assert_eq!(hit, c(8, 11, 0, 1, 5));
+    assert_eq!((hit.mul, hit.add - 2, hit.sqrt), (8, 9, 1));
+    // "The point adds 3 multiplies and 3 additions."
+    assert_eq!(get("sphere-point", "hit"), c(3, 3, 0, 0, 0));
+}
+
+#[test]
+fn geometric_miss_is_v_plus_the_test() {
+    // v = T·U: 3 mul, 2 add; the test r² ≥ c² − v²: 1 mul, 1 sub, 1 compare.
+    assert_eq!(get("geometric-prepared", "miss"), c(3 + 1, 2 + 1, 0, 0, 1));
+    // The hit adds the half chord (1 sub, 1 sqrt) and the two roots v ∓ d (2 add).
+    assert_eq!(get("geometric-prepared", "hit"), c(4, 6, 0, 1, 5));
+    // Unprepared, T = C − E (3 add), c² (3 mul, 2 add) and r² (1 mul) come first.
+    assert_eq!(get("geometric", "miss"), c(8, 8, 0, 0, 1));
+}
+
+#[test]
+fn focal_miss_within_four_mul_two_add() {
+    let miss = get("focal", "miss");
+    assert!(miss.mul <= 4 && miss.add <= 2, "{miss}");
+    assert_eq!(miss, c(4, 2, 0, 0, 1));
+    // The guard costs nothing on the miss path: the unguarded test is the same.
+    assert_eq!(get("focal-unguarded", "miss"), miss);
+    // A certain hit: perpendicular form (6 mul, 5 add), half chord (1 add, 1 sqrt), roots.
+    assert_eq!(get("focal", "hit"), c(10, 10, 0, 1, 9));
+    assert_eq!(get("focal-unguarded", "hit"), c(4, 5, 0, 1, 5));
+}
+
+#[test]
+fn every_other_count_is_pinned() {
+    let want = [
+        ("quadratic", "miss", c(12, 11, 0, 0, 1)),
+        ("quadratic", "hit", c(12, 13, 2, 1, 5)),
+        ("geometric", "hit", c(8, 11, 0, 1, 5)),
+        ("robust", "miss", c(14, 13, 1, 0, 1)),
+        ("robust", "hit", c(17, 17, 3, 1, 6)),
+        ("focal", "doubtful", c(27, 27, 3, 2, 15)),
+        ("sphere-surface", "hit", c(9, 10, 3, 1, 0)),
+        ("plane", "miss", c(6, 7, 1, 0, 2)),
+        ("plane", "hit", c(6, 7, 1, 0, 2)),
+        ("plane-focal", "miss", c(3, 2, 1, 0, 2)),
+        ("plane-focal", "hit", c(3, 2, 1, 0, 2)),
+    ];
+    for (k, p, n) in want {
+        assert_eq!(get(k, p), n, "{k}/{p}");
+    }
+}
