@@ -9,8 +9,17 @@
 //! * **1 ray × N primitives** ([`closest_soa`], [`any_soa`]): primitives sit in lanes (structure
 //!   of arrays), the ray is splatted, and the lanes are reduced at the end.
 //!
-//! Both shapes return the same hit, bit for bit: each test computes `t` the same way whatever
-//! the lane, and ties go to the lowest primitive index.
+//! Both shapes return the same hit, bit for bit, whatever the order the primitives are visited
+//! in: a candidate is taken only when its rounded `t` is strictly below the best so far (ties
+//! go to the lowest primitive index), and after each hit the rays' `t_max` is relaxed to
+//! `t + |t|·2^-21` rather than set to `t`. A kernel may then reject `t ≥ t_max` before its
+//! division as `num < t_max·den` (one multiply, rounded): the relaxation makes that test
+//! conservative, so no would-be winner is dropped and the division runs only for the hits that
+//! win so far.
+//!
+//! Kernels with a deferred division report `u`, `v` unscaled with their denominator (see
+//! [`LaneHit::deferred`]); the loops divide once per ray, for the winner, and every record a
+//! caller sees is normalised.
 //!
 //! Misses are canonical: `t = +inf`, `u = v = 0`, index `u32::MAX`. No record ever holds a NaN.
 
@@ -28,6 +37,8 @@ pub struct LaneHit<L: Lane> {
     pub v: L,
     /// Lanes that hit inside the ray interval.
     pub mask: L::Mask,
+    /// Denominator of `u` and `v` while a query runs (1 once normalised).
+    pub(crate) w: L,
 }
 
 impl<L: Lane> LaneHit<L> {
@@ -41,6 +52,7 @@ impl<L: Lane> LaneHit<L> {
             u: zero,
             v: zero,
             mask: Mask::splat(false),
+            w: L::from_f32(1.0),
         }
     }
 
@@ -48,12 +60,33 @@ impl<L: Lane> LaneHit<L> {
     #[inline(always)]
     #[must_use]
     pub fn new(t: L, u: L, v: L, mask: L::Mask) -> Self {
+        Self::deferred(t, u, v, L::from_f32(1.0), mask)
+    }
+
+    /// A hit whose barycentrics are `u/w`, `v/w`: the division is left to the loops, which do
+    /// it once per ray for the winner ([`normalized`](Self::normalized)).
+    #[inline(always)]
+    #[must_use]
+    pub fn deferred(t: L, u: L, v: L, w: L, mask: L::Mask) -> Self {
         let zero = L::from_f32(0.0);
         LaneHit {
             t: L::select(mask, t, L::from_f32(f32::INFINITY)),
             u: L::select(mask, u, zero),
             v: L::select(mask, v, zero),
             mask,
+            w: L::select(mask, w, L::from_f32(1.0)),
+        }
+    }
+
+    /// `u/w`, `v/w` (2 div): the record as callers see it.
+    #[inline(always)]
+    #[must_use]
+    pub fn normalized(self) -> Self {
+        LaneHit {
+            u: self.u / self.w,
+            v: self.v / self.w,
+            w: L::from_f32(1.0),
+            ..self
         }
     }
 }
@@ -71,6 +104,8 @@ pub struct Hit<L: Lane> {
     pub index: L::Indices,
     /// Lanes that hit.
     pub mask: L::Mask,
+    /// Denominator of `u` and `v` while a query runs (1 once finished).
+    pub(crate) w: L,
 }
 
 /// One hit of one ray, as the scalar API reports it.
@@ -98,6 +133,7 @@ impl<L: Lane> Hit<L> {
             v: m.v,
             index: L::indices(u32::MAX),
             mask: m.mask,
+            w: m.w,
         }
     }
 
@@ -116,18 +152,41 @@ impl<L: Lane> Hit<L> {
         })
     }
 
-    /// Takes the hits of `h` (which must be closer where set) for primitive `index`.
+    /// Takes the hits of `h` in the lanes of `take` for primitive `index`.
     #[inline(always)]
-    pub fn update(&mut self, h: &LaneHit<L>, index: u32) {
-        if h.mask.any() {
-            self.t = L::select(h.mask, h.t, self.t);
-            self.u = L::select(h.mask, h.u, self.u);
-            self.v = L::select(h.mask, h.v, self.v);
-            self.mask = self.mask | h.mask;
-            select_indices::<L>(h.mask, index, &mut self.index);
-        }
+    fn take(&mut self, h: &LaneHit<L>, take: L::Mask, index: u32) {
+        self.t = L::select(take, h.t, self.t);
+        self.u = L::select(take, h.u, self.u);
+        self.v = L::select(take, h.v, self.v);
+        self.w = L::select(take, h.w, self.w);
+        self.mask = self.mask | take;
+        select_indices::<L>(take, index, &mut self.index);
+    }
+
+    /// Divides the winners' barycentrics by their denominators (once per ray).
+    #[inline(always)]
+    fn finish(mut self) -> Self {
+        self.u = self.u / self.w;
+        self.v = self.v / self.w;
+        self.w = L::from_f32(1.0);
+        self
     }
 }
+
+/// Lanes of `h` strictly closer than `best` (ties keep the earlier, lower-index hit).
+#[inline(always)]
+fn closer<L: Lane>(h: &LaneHit<L>, best: &Hit<L>) -> L::Mask {
+    h.mask & h.t.lt(best.t)
+}
+
+/// The relaxed upper end after a hit at `t`: `t + |t|·2^-21` (> t after rounding), so that a
+/// kernel's rounded `num < t_max·den` never rejects a hit that rounds below `t`.
+#[inline(always)]
+fn relax<L: Lane>(t: L) -> L {
+    t + t.abs() * L::from_f32(1.0 / 2_097_152.0)
+}
+
+impl<L: Lane> Hit<L> {}
 
 impl Hit<f32> {
     /// The record, or `None` for a miss.
@@ -154,13 +213,14 @@ pub fn closest<L: Lane, P>(
     for (i, p) in prims.into_iter().enumerate() {
         // `None`: no lane passed the kernel's first test (nothing to merge on the miss path).
         if let Some(h) = test(&r, p) {
-            if h.mask.any() {
-                best.update(&h, i as u32);
-                r = r.shrink(h.mask, h.t);
+            let take = closer(&h, &best);
+            if take.any() {
+                best.take(&h, take, i as u32);
+                r = r.shrink(take, relax(h.t));
             }
         }
     }
-    best
+    best.finish()
 }
 
 /// True in lanes where some primitive is hit (occlusion); stops when every valid lane is hit.
@@ -206,14 +266,15 @@ pub fn closest_filtered<L: Lane, P>(
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;
             if let Some(h) = test(&r, &block[j]) {
-                if h.mask.any() {
-                    best.update(&h, (b * 64 + j) as u32);
-                    r = r.shrink(h.mask, h.t);
+                let take = closer(&h, &best);
+                if take.any() {
+                    best.take(&h, take, (b * 64 + j) as u32);
+                    r = r.shrink(take, relax(h.t));
                 }
             }
         }
     }
-    best
+    best.finish()
 }
 
 /// [`any`] in two passes per block of 64 primitives, as [`closest_filtered`].
@@ -263,20 +324,25 @@ where
     let mut best = Hit::<L>::none();
     for (c, p) in chunks.into_iter().enumerate() {
         let Some(h) = test(&r, p) else { continue };
-        if h.mask.any() {
-            let mut bits = h.mask.bits();
+        let take = closer(&h, &best);
+        if take.any() {
+            let mut bits = take.bits();
             while bits != 0 {
                 let j = bits.trailing_zeros() as usize;
-                best.index.as_mut()[j] = (c * L::LANES + j) as u32;
+                if let Some(slot) = best.index.as_mut().get_mut(j) {
+                    *slot = (c * L::LANES + j) as u32;
+                }
                 bits &= bits - 1;
             }
-            best.t = L::select(h.mask, h.t, best.t);
-            best.u = L::select(h.mask, h.u, best.u);
-            best.v = L::select(h.mask, h.v, best.v);
-            best.mask = best.mask | h.mask;
-            r = r.shrink(h.mask, h.t);
+            best.t = L::select(take, h.t, best.t);
+            best.u = L::select(take, h.u, best.u);
+            best.v = L::select(take, h.v, best.v);
+            best.w = L::select(take, h.w, best.w);
+            best.mask = best.mask | take;
+            r = r.shrink(take, relax(h.t));
         }
     }
+    let best = best.finish();
     // Reduce across lanes: smallest t, ties to the lowest index.
     let mut out: Option<HitRecord> = None;
     for j in 0..L::LANES {

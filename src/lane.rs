@@ -205,23 +205,23 @@ pub fn sqrt_f32(x: f32) -> f32 {
 #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
 #[inline(always)]
 fn arm_vsqrt(x: f32) -> f32 {
-    let out: u32;
-    // SAFETY: pure register arithmetic on the FPU (present on every eabihf target); s0's old
-    // value is saved in a core register and restored, so no FPU register is clobbered.
+    // Stable Rust refuses the `sreg` register class on thumb targets, but accepts `s0` named
+    // as a discarded output, which LLVM treats as a clobber: the value travels through a core
+    // register and nothing live is kept in s0.
+    let mut bits = x.to_bits();
+    // SAFETY: vsqrt.f32 reads and writes only s0 (declared clobbered) and FPSCR's cumulative
+    // exception flags; every eabihf target has the FPU.
     unsafe {
         core::arch::asm!(
-            "vmov {save}, s0",
-            "vmov s0, {x}",
+            "vmov s0, {v}",
             "vsqrt.f32 s0, s0",
-            "vmov {out}, s0",
-            "vmov s0, {save}",
-            x = in(reg) x.to_bits(),
-            out = lateout(reg) out,
-            save = out(reg) _,
-            options(pure, nomem, nostack),
+            "vmov {v}, s0",
+            v = inout(reg) bits,
+            out("s0") _,
+            options(pure, nomem, nostack, preserves_flags),
         );
     }
-    f32::from_bits(out)
+    f32::from_bits(bits)
 }
 
 impl Lane for f32 {
@@ -463,8 +463,9 @@ pub(crate) fn select_indices<L: Lane>(mask: L::Mask, a: u32, b: &mut L::Indices)
     let mut bits = mask.bits();
     let out = b.as_mut();
     while bits != 0 {
-        let i = bits.trailing_zeros() as usize;
-        out[i] = a;
+        if let Some(slot) = out.get_mut(bits.trailing_zeros() as usize) {
+            *slot = a;
+        }
         bits &= bits - 1;
     }
 }

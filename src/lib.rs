@@ -1,8 +1,8 @@
 //! # raylane
 //!
-//! Ray–sphere, ray–plane (and, with the triangle module, ray–triangle) intersection kernels
-//! that test many rays at once in SIMD lanes, spend as few floating-point operations as the
-//! mathematics allows, and give the same bits on x86-64, AArch64 and Cortex-M.
+//! Ray–sphere, ray–plane and ray–triangle intersection kernels that test many rays at once in
+//! SIMD lanes, spend as few floating-point operations as the mathematics allows, and give the
+//! same bits on x86-64, AArch64 and Cortex-M.
 //!
 //! * **One body of math per kernel.** Every kernel is a generic function over [`Lane`]:
 //!   `f32` (the scalar reference), `f64`, `wide::f32x4`/`f32x8`/`f32x16` packets, and
@@ -18,16 +18,20 @@
 //! * A ray is `o + t·d` over an open interval: a hit needs `t_min < t < t_max`
 //!   ([`Ray::new`] uses `(0, +inf)`). `t` is in units of `|d|`.
 //! * Directions need not be unit length, except for the methods that say so:
-//!   [`sphere::QuadraticUnit`], [`sphere::Geometric`] and the focal caches
+//!   [`sphere::QuadraticUnit`], [`sphere::Geometric`] and the sphere focal caches
 //!   ([`sphere::focal`]). Those normalise nothing.
 //! * Sphere kernels return every root inside the interval, ascending.
+//! * Triangle hits carry barycentrics: `u` weighs vertex B, `v` vertex C. Triangles are
+//!   two-sided unless back faces are culled ([`triangle::Cull`]); the `watertight` and `focal`
+//!   kernels never let a ray slip between triangles that share an edge or a vertex.
 //! * Misses are canonical: `t = +inf`, index `u32::MAX`; no hit record ever holds a NaN.
 //!
 //! ## Layout
 //!
 //! [`lane`] (the abstraction), [`vec3`] (`V3<L>`, SoA vectors), [`ray`] (rays and packets),
-//! [`camera`] (pinhole primary rays from one focal point), [`sphere`], [`plane`], [`hit`]
-//! (records and the closest/any loops), [`opcount`] (the counting lane), and, behind the
+//! [`camera`] (pinhole primary rays from one focal point), [`sphere`], [`plane`], [`triangle`],
+//! [`mesh`] (triangles over shared vertex slices), [`bounds`] (bounding spheres and culling),
+//! [`hit`] (records and the closest/any loops), [`opcount`] (the counting lane), and, behind the
 //! `vectors` feature, [`vectors`] (the test-vector parser, runner and digest shared by the
 //! checker, the tests and the firmware).
 //!
@@ -47,13 +51,16 @@
 #![deny(missing_docs)]
 #![forbid(unsafe_op_in_unsafe_fn)]
 
+pub mod bounds;
 pub mod camera;
 pub mod hit;
 pub mod lane;
+pub mod mesh;
 pub mod opcount;
 pub mod plane;
 pub mod ray;
 pub mod sphere;
+pub mod triangle;
 pub mod vec3;
 #[cfg(feature = "vectors")]
 pub mod vectors;

@@ -259,12 +259,29 @@ pub struct Row {
 /// The report: every kernel on a miss and on a hit, measured with `Counted<f32>` on the
 /// lectures' worked examples (sphere centre (5,5,5), radius 3; the miss ray from the origin
 /// along (1,3,4)/√26, the hit ray from (1,0,1) along (1,2,1)/√6).
+///
+/// Triangles: A = (0,0,0), B = (4,0,0), C = (0,3,0) and rays along (0,0,−1) (`Ray::new`,
+/// interval (0, inf)): the hit from (1,1,5) (t = 5, u = 1/4, v = 1/3), the miss from (3,2,5)
+/// (beyond edge BC: the latest exit of every kernel), `miss (β)` from (−1,1,5) (Cramer's
+/// first exit), `behind` from (1,1,−5) along (0,0,−1) (the edges pass, the interval fails:
+/// everything before the division), `zero edge` and `doubtful` from (1,1,5) through the point
+/// (2,0,0) of edge AB (the exact fallbacks, both hits: the watertight kernel's `f64` edge
+/// functions are counted, the focal kernel's exact predicate is not), and `per ray` the setup
+/// a query does once per ray ([`Shear::new`](crate::triangle::Shear::new),
+/// [`FocalRays::new`](crate::triangle::FocalRays::new)). `bound` is the conservative
+/// line–sphere culling test of [`Bound::may_hit`](crate::bounds::Bound::may_hit), per ray and
+/// mesh.
 #[must_use]
-pub fn table() -> [Row; 21] {
+pub fn table() -> [Row; 37] {
     use crate::plane::{self, FocalPlane, Plane, PlanePacket};
     use crate::ray::{Ray, RayPacket};
     use crate::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
     use crate::sphere::{self as sp, FocalSphere, Geometric, SphereKernel, SpherePacket};
+    use crate::triangle::focal as tf;
+    use crate::triangle::{
+        Cramer, Cull, FocalRays, FocalTriangle, Moller, Shear, Triangle, TriangleKernel,
+        TrianglePacket, Watertight,
+    };
     use glam::Vec3;
 
     type C = Counted<f32>;
@@ -288,7 +305,7 @@ pub fn table() -> [Row; 21] {
     }
     let prepared = |r: &Ray| {
         let rp = RayPacket::<C>::splat(r);
-        let p = Geometric::prepare(rp.origin(), &SpherePacket::splat(&ball));
+        let p = measure(|| Geometric::prepare(rp.origin(), &SpherePacket::splat(&ball))).0;
         measure(|| Geometric::roots_prepared(&rp, &p)).1
     };
     let surface = |r: &Ray, t: f32, with: bool| {
@@ -315,6 +332,43 @@ pub fn table() -> [Row; 21] {
             let pp = PlanePacket::<C>::splat(p);
             measure(|| plane::intersect_lanes(&rp, &pp)).1
         }
+    };
+    let tri = Triangle::new(
+        Vec3::ZERO,
+        Vec3::new(4.0, 0.0, 0.0),
+        Vec3::new(0.0, 3.0, 0.0),
+    );
+    let down = Vec3::new(0.0, 0.0, -1.0);
+    let t_hit = Ray::new(Vec3::new(1.0, 1.0, 5.0), down);
+    let t_miss = Ray::new(Vec3::new(3.0, 2.0, 5.0), down);
+    let t_beta = Ray::new(Vec3::new(-1.0, 1.0, 5.0), down);
+    let t_behind = Ray::new(Vec3::new(1.0, 1.0, -5.0), down);
+    let t_edge = Ray::new(Vec3::new(1.0, 1.0, 5.0), Vec3::new(1.0, -1.0, -5.0));
+    // Setup on counted lanes runs inside `measure` too (counts discarded): the counters are
+    // global, and only what runs under its lock stays out of concurrent measurements.
+    fn tri_count<K: TriangleKernel>(r: &Ray, t: &Triangle) -> OpCounts {
+        let rp = RayPacket::<C>::splat(r);
+        let pre = measure(|| K::prepare(&rp)).0;
+        let tp = TrianglePacket::<C>::splat(t);
+        measure(|| K::intersect(&rp, &pre, &tp, Cull::None)).1
+    }
+    let focal_tri = |r: &Ray| {
+        let e = FocalTriangle::<C>::splat(&FocalTriangle::new(r.origin(), &tri));
+        let fr = measure(|| FocalRays::<C>::new(&RayPacket::splat(r))).0;
+        measure(|| tf::kernel(fr.scaled(), &e, Cull::None)).1
+    };
+    let per_ray = |focal: bool| {
+        let rp = RayPacket::<C>::splat(&t_hit);
+        if focal {
+            measure(|| FocalRays::new(&rp)).1
+        } else {
+            measure(|| Shear::new(&rp)).1
+        }
+    };
+    let bound = {
+        let b = crate::bounds::Bound::new(&sp::Sphere::new(Vec3::new(2.0, 1.5, 0.0), 2.5));
+        let rp = RayPacket::<C>::splat(&t_hit);
+        measure(|| b.may_hit(&rp)).1
     };
     let row = |kernel, path, counts| Row {
         kernel,
@@ -371,5 +425,25 @@ pub fn table() -> [Row; 21] {
         row("plane", "hit", plane_count(&wall, false)),
         row("plane-focal", "miss", plane_count(&behind, true)),
         row("plane-focal", "hit", plane_count(&wall, true)),
+        row("cramer", "miss (β)", tri_count::<Cramer>(&t_beta, &tri)),
+        row("cramer", "miss", tri_count::<Cramer>(&t_miss, &tri)),
+        row("cramer", "hit", tri_count::<Cramer>(&t_hit, &tri)),
+        row("moller", "miss", tri_count::<Moller>(&t_miss, &tri)),
+        row("moller", "behind", tri_count::<Moller>(&t_behind, &tri)),
+        row("moller", "hit", tri_count::<Moller>(&t_hit, &tri)),
+        row("watertight", "per ray", per_ray(false)),
+        row("watertight", "miss", tri_count::<Watertight>(&t_miss, &tri)),
+        row("watertight", "hit", tri_count::<Watertight>(&t_hit, &tri)),
+        row(
+            "watertight",
+            "zero edge",
+            tri_count::<Watertight>(&t_edge, &tri),
+        ),
+        row("triangle-focal", "per ray", per_ray(true)),
+        row("triangle-focal", "miss", focal_tri(&t_miss)),
+        row("triangle-focal", "behind", focal_tri(&t_behind)),
+        row("triangle-focal", "hit", focal_tri(&t_hit)),
+        row("triangle-focal", "doubtful", focal_tri(&t_edge)),
+        row("bound", "per mesh", bound),
     ]
 }

@@ -30,6 +30,10 @@ use crate::sphere::{
     FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Roots, Sphere, SphereKernel,
     SpherePacket,
 };
+use crate::triangle::{
+    self, Cramer, Cull, FocalRays, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket,
+    Watertight,
+};
 use crate::vec3::V3;
 
 /// Relative tolerance on `t`.
@@ -159,6 +163,11 @@ impl Case {
     pub fn plane(&self) -> Plane {
         Plane::new(self.vec(0), self.vec(1))
     }
+    /// The triangle of a triangle case.
+    #[must_use]
+    pub fn triangle(&self) -> Triangle {
+        Triangle::new(self.vec(0), self.vec(1), self.vec(2))
+    }
 }
 
 /// Why a line could not be read.
@@ -254,18 +263,25 @@ pub enum Method {
     Geometric,
     /// [`Robust`]: spheres.
     Robust,
-    /// The guarded focal caches: spheres ([`Focal`], unit directions) and planes
-    /// ([`FocalPlane`]).
+    /// The focal caches: spheres ([`Focal`], guarded, unit directions), planes
+    /// ([`FocalPlane`]) and triangles ([`FocalTriangle`], any direction); per case the eye is
+    /// the ray origin.
     Focal,
     /// [`FocalUnguarded`]: spheres, unit directions.
     FocalUnguarded,
     /// The ray–plane test.
     Plane,
+    /// [`Cramer`]: triangles (lecture 002).
+    Cramer,
+    /// [`Moller`]: triangles (Möller–Trumbore, division deferred).
+    Moller,
+    /// [`Watertight`]: triangles (Woop, Benthin, Wald 2013).
+    Watertight,
 }
 
 impl Method {
     /// Every method, in report order.
-    pub const ALL: [Method; 7] = [
+    pub const ALL: [Method; 10] = [
         Method::Quadratic,
         Method::QuadraticUnit,
         Method::Geometric,
@@ -273,6 +289,9 @@ impl Method {
         Method::Focal,
         Method::FocalUnguarded,
         Method::Plane,
+        Method::Cramer,
+        Method::Moller,
+        Method::Watertight,
     ];
 
     /// The checker's name.
@@ -286,6 +305,9 @@ impl Method {
             Method::Focal => Focal::NAME,
             Method::FocalUnguarded => FocalUnguarded::NAME,
             Method::Plane => "plane",
+            Method::Cramer => Cramer::NAME,
+            Method::Moller => Moller::NAME,
+            Method::Watertight => Watertight::NAME,
         }
     }
 
@@ -299,9 +321,15 @@ impl Method {
     #[must_use]
     pub fn applies(self, kind: Kind) -> bool {
         match kind {
-            Kind::Sphere => !matches!(self, Method::Plane),
+            Kind::Sphere => !matches!(
+                self,
+                Method::Plane | Method::Cramer | Method::Moller | Method::Watertight
+            ),
             Kind::Plane => matches!(self, Method::Plane | Method::Focal),
-            Kind::Triangle => false,
+            Kind::Triangle => matches!(
+                self,
+                Method::Cramer | Method::Moller | Method::Watertight | Method::Focal
+            ),
         }
     }
 
@@ -311,7 +339,7 @@ impl Method {
         match kind {
             Kind::Sphere => Some(Method::Robust),
             Kind::Plane => Some(Method::Plane),
-            Kind::Triangle => None,
+            Kind::Triangle => Some(Method::Watertight),
         }
     }
 
@@ -446,6 +474,8 @@ mod limits {
             }
             // Exact decisions and t within 2^-17 for unit directions and any c/r.
             Method::Focal | Method::Plane => Limit::Inside,
+            // Triangle methods never reach here (only sphere cases are limited).
+            Method::Cramer | Method::Moller | Method::Watertight => Limit::Inside,
         }
     }
 }
@@ -531,7 +561,7 @@ fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outco
                         FocalUnguarded::roots(&ray, &cache)
                     }
                 }
-                Method::Plane => Roots::miss(),
+                _ => Roots::miss(),
             };
             for (k, o) in out.iter_mut().enumerate() {
                 let (t, m) = roots.lane(k);
@@ -571,8 +601,46 @@ fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outco
                 };
             }
         }
-        Kind::Triangle => out.iter_mut().for_each(|o| *o = Outcome::default()),
+        Kind::Triangle => {
+            let tris = TrianglePacket::<L>::from_fn(|i| get(i).triangle());
+            let two_sided = Cull::None;
+            let h = match method {
+                Method::Cramer => tri_lanes::<Cramer, L>(&ray, &tris),
+                Method::Moller => tri_lanes::<Moller, L>(&ray, &tris),
+                Method::Watertight => tri_lanes::<Watertight, L>(&ray, &tris),
+                _ => {
+                    // A per-case cache with the eye at the ray origin.
+                    let mut e = [FocalTriangle::never(); 16];
+                    for (k, c) in cases.iter().enumerate() {
+                        e[k] = FocalTriangle::new(c.origin(), &c.triangle());
+                    }
+                    let cache = FocalTriangle::<L>::gather(&e[..n]);
+                    triangle::focal::intersect_lanes(&FocalRays::new(&ray), &cache, two_sided)
+                }
+            };
+            for (k, o) in out.iter_mut().enumerate() {
+                let values = if h.mask.test(k) {
+                    Values {
+                        n: 3,
+                        v: [h.t.lane(k), h.u.lane(k), h.v.lane(k)],
+                    }
+                } else {
+                    Values::MISS
+                };
+                *o = Outcome {
+                    applicable: true,
+                    values,
+                };
+            }
+        }
     }
+}
+
+fn tri_lanes<K: TriangleKernel, L: Lane>(
+    ray: &RayPacket<L>,
+    tris: &TrianglePacket<L>,
+) -> crate::hit::LaneHit<L> {
+    K::intersect(ray, &K::prepare(ray), tris, Cull::None).normalized()
 }
 
 fn sphere_list(cases: &[Case]) -> [Sphere; 16] {

@@ -8,7 +8,7 @@ use raylane::sphere::{
     self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere, SphereKernel,
     SpherePacket,
 };
-use raylane::{Lane, Mask, Ray, RayPacket};
+use raylane::{Lane, Ray, RayPacket};
 use wide::f32x8;
 
 const NAN: f32 = f32::NAN;

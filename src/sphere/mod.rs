@@ -204,6 +204,7 @@ impl<L: Lane> Roots<L> {
             u: zero,
             v: zero,
             mask: self.m0 | self.m1,
+            w: L::from_f32(1.0),
         }
     }
 

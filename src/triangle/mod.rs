@@ -1,0 +1,376 @@
+//! Ray–triangle intersection: four formulations over one lane abstraction.
+//!
+//! | kernel | from | per-ray setup | watertight | strength |
+//! | --- | --- | --- | --- | --- |
+//! | [`Cramer`] | lecture 002: the 3×3 system by Cramer's rule | none | no | the textbook; three divisions, early exits |
+//! | [`Moller`] | Möller & Trumbore 1997, division deferred (as in Embree) | none | no | fewest operations without per-ray setup |
+//! | [`Watertight`] | Woop, Benthin & Wald 2013 | shear, 3 div | yes (no leaks; edges may be hit twice) | any ray, any triangle |
+//! | [`focal`] | rays from one focal point, edge normals cached per triangle | exact power-of-two scale | yes, and each crossing is reported once | 9 mul + 6 add per miss |
+//!
+//! **Conventions.** A hit satisfies `o + t·d = A + u(B − A) + v(C − A)` with `t_min < t <
+//! t_max`, `u ≥ 0`, `v ≥ 0`, `u + v ≤ 1`: `u` weighs vertex B and `v` vertex C. Triangles
+//! are two-sided unless [`Cull::Back`] is asked for, which keeps only front faces: `d·N < 0`
+//! with `N = (B − A) × (C − A)`, i.e. A, B, C counter-clockwise as seen from the ray origin.
+//! Directions need not be unit length; `t` is in units of `|d|`.
+//!
+//! **Deferred division.** [`Moller`], [`Watertight`] and [`focal`] test the edges against the
+//! unscaled determinant, `t > 0` as the sign of its numerator and `t < t_max` as
+//! `num_t < t_max·|det|`; only lanes that pass divide, `t = num_t/|det|`, and a hit needs the
+//! rounded `t` strictly inside `(t_min, t_max)`. In a closest-hit loop that is only the hits
+//! that win so far: the loops relax `t_max` after each hit so that the rounded product never
+//! drops a winner, and take a candidate only when its rounded `t` is below the best, so every
+//! traversal order and both packet shapes find the same closest hit, bit for bit (see
+//! [`hit`](crate::hit)). `u`, `v` are divided once per ray, for the winner.
+//!
+//! **Entry points.** [`intersect`] (one ray, one triangle), [`closest`], [`any`], [`all`] (ray
+//! packets over a slice of triangles: N rays × 1 triangle) and [`closest_soa`], [`any_soa`]
+//! (one ray over triangles packed in lanes, like Embree's `Triangle4`: 1 ray × N triangles).
+//! Meshes over shared vertex slices are in [`mesh`](crate::mesh); the focal cache has the same
+//! set in [`focal`].
+//!
+//! **Bad input.** [`Triangle::new`] stores a triangle with a non-finite coordinate or exactly
+//! zero area (collinear vertices, decided exactly) with NaN vertices, and every kernel misses
+//! it; bad rays are sanitised by their constructors. No record ever holds a NaN.
+//!
+//! ```
+//! use glam::Vec3;
+//! use raylane::triangle::{self, Cull, FocalTriangle, Triangle, Watertight};
+//! use raylane::{Ray, RayPacket};
+//!
+//! let tri = Triangle::new(Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0));
+//! let ray = Ray::new(Vec3::new(1.0, 1.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+//! let hit = triangle::intersect::<Watertight>(&ray, &tri, Cull::None).unwrap();
+//! assert_eq!((hit.t, hit.u), (5.0, 0.25)); // u weighs B, v weighs C
+//!
+//! // Rays from one eye: cache the triangle once, then 9 mul + 6 add per missing ray.
+//! let cache = [FocalTriangle::new(ray.origin(), &tri)];
+//! let rays = RayPacket::<wide::f32x8>::splat(&ray);
+//! let hits = triangle::focal::closest(&rays, &cache, Cull::Back); // front faces only
+//! assert_eq!(hits.lane(7).unwrap().t, 5.0);
+//! ```
+
+mod cramer;
+pub(crate) mod exact;
+pub mod focal;
+mod moller;
+mod watertight;
+
+pub use cramer::Cramer;
+pub use focal::{FocalRays, FocalTriangle};
+pub use moller::Moller;
+pub use watertight::{Shear, Watertight};
+
+use glam::Vec3;
+
+use crate::hit::{self, Hit, HitRecord, LaneHit};
+use crate::lane::{Lane, Mask};
+use crate::ray::{Ray, RayPacket};
+use crate::vec3::V3;
+
+/// Which faces a triangle test reports.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Cull {
+    /// Two-sided (the default): hits from either side.
+    #[default]
+    None,
+    /// Back-face culling: only front faces, `d·N < 0` with `N = (B − A) × (C − A)`.
+    Back,
+}
+
+impl Cull {
+    /// True for [`Cull::Back`].
+    #[inline(always)]
+    #[must_use]
+    pub fn back(self) -> bool {
+        matches!(self, Cull::Back)
+    }
+}
+
+/// A triangle: three vertices.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Triangle {
+    a: Vec3,
+    b: Vec3,
+    c: Vec3,
+}
+
+impl Triangle {
+    /// A triangle; a non-finite coordinate or exactly zero area (decided exactly) gives a
+    /// triangle that is never hit (its vertices are stored as NaN).
+    #[must_use]
+    pub fn new(a: Vec3, b: Vec3, c: Vec3) -> Self {
+        let w = |v: Vec3| [v.x as f64, v.y as f64, v.z as f64];
+        let ok =
+            a.is_finite() && b.is_finite() && c.is_finite() && !exact::collinear(w(a), w(b), w(c));
+        if ok {
+            Triangle { a, b, c }
+        } else {
+            Self::never()
+        }
+    }
+
+    /// A triangle that is never hit (NaN vertices).
+    #[must_use]
+    pub const fn never() -> Self {
+        let nan = Vec3::splat(f32::NAN);
+        Triangle {
+            a: nan,
+            b: nan,
+            c: nan,
+        }
+    }
+
+    /// Vertex A.
+    #[inline]
+    #[must_use]
+    pub fn a(&self) -> Vec3 {
+        self.a
+    }
+
+    /// Vertex B (weighted by `u`).
+    #[inline]
+    #[must_use]
+    pub fn b(&self) -> Vec3 {
+        self.b
+    }
+
+    /// Vertex C (weighted by `v`).
+    #[inline]
+    #[must_use]
+    pub fn c(&self) -> Vec3 {
+        self.c
+    }
+
+    /// False for a triangle made from bad input.
+    #[inline]
+    #[must_use]
+    pub fn is_valid(&self) -> bool {
+        !self.a.x.is_nan()
+    }
+
+    /// The point with barycentrics `u` (of B) and `v` (of C): `A + u(B − A) + v(C − A)`.
+    #[inline]
+    #[must_use]
+    pub fn point(&self, u: f32, v: f32) -> Vec3 {
+        self.a + (self.b - self.a) * u + (self.c - self.a) * v
+    }
+}
+
+/// Triangles in lanes (structure of arrays): lane `i` of each field is triangle `i`.
+#[derive(Clone, Copy, Debug)]
+pub struct TrianglePacket<L: Lane> {
+    pub(crate) a: V3<L>,
+    pub(crate) b: V3<L>,
+    pub(crate) c: V3<L>,
+}
+
+impl<L: Lane> TrianglePacket<L> {
+    /// The same triangle in every lane.
+    #[inline(always)]
+    #[must_use]
+    pub fn splat(t: &Triangle) -> Self {
+        TrianglePacket {
+            a: V3::splat(t.a),
+            b: V3::splat(t.b),
+            c: V3::splat(t.c),
+        }
+    }
+
+    /// Lane `i` holds `f(i)`.
+    #[inline]
+    #[must_use]
+    pub fn from_fn(mut f: impl FnMut(usize) -> Triangle) -> Self {
+        let mut t = [Triangle::never(); 16];
+        for (i, slot) in t.iter_mut().enumerate().take(L::LANES) {
+            *slot = f(i);
+        }
+        TrianglePacket {
+            a: V3::from_fn(|i| t[i].a),
+            b: V3::from_fn(|i| t[i].b),
+            c: V3::from_fn(|i| t[i].c),
+        }
+    }
+
+    /// Up to `L::LANES` triangles, one per lane; lanes past `tris.len()` are never hit.
+    #[must_use]
+    pub fn from_triangles(tris: &[Triangle]) -> Self {
+        Self::from_fn(|i| tris.get(i).copied().unwrap_or(Triangle::never()))
+    }
+
+    /// Fills `out` with `tris` in chunks of `L::LANES` (the last chunk padded with triangles
+    /// that are never hit); returns the number of chunks written (at most `out.len()`).
+    pub fn pack(tris: &[Triangle], out: &mut [TrianglePacket<L>]) -> usize {
+        let mut n = 0;
+        for (chunk, slot) in tris.chunks(L::LANES).zip(out.iter_mut()) {
+            *slot = Self::from_triangles(chunk);
+            n += 1;
+        }
+        n
+    }
+
+    /// Vertices A.
+    #[inline]
+    #[must_use]
+    pub fn a(&self) -> V3<L> {
+        self.a
+    }
+
+    /// Vertices B.
+    #[inline]
+    #[must_use]
+    pub fn b(&self) -> V3<L> {
+        self.b
+    }
+
+    /// Vertices C.
+    #[inline]
+    #[must_use]
+    pub fn c(&self) -> V3<L> {
+        self.c
+    }
+}
+
+/// A ray–triangle formulation: ray lanes against triangle lanes.
+///
+/// Implemented by [`Cramer`], [`Moller`] and [`Watertight`]; one generic body each, shared by
+/// every lane width and by the op-counting lane. [`prepare`](Self::prepare) computes what
+/// depends on the rays only (once per packet and query); [`intersect`](Self::intersect) runs
+/// per triangle.
+pub trait TriangleKernel {
+    /// The method's name (as the checker spells it).
+    const NAME: &'static str;
+    /// Per-ray constants (`()` for the methods that need none).
+    type Rays<L: Lane>: Copy;
+    /// The per-ray constants of `rays`.
+    fn prepare<L: Lane>(rays: &RayPacket<L>) -> Self::Rays<L>;
+    /// The hit of each ray lane on the triangle in the same lane (`pre` from
+    /// [`prepare`](Self::prepare) of the same rays; `ray` may have a shrunk `t_max`).
+    ///
+    /// The kernels that defer their division return `u`, `v` still scaled by the determinant:
+    /// call [`LaneHit::normalized`] before reading them (the entry points of this module do).
+    fn intersect<L: Lane>(
+        ray: &RayPacket<L>,
+        pre: &Self::Rays<L>,
+        tri: &TrianglePacket<L>,
+        cull: Cull,
+    ) -> LaneHit<L>;
+}
+
+/// The steps shared by the deferred-division kernels, for lanes in `mask` whose edge tests
+/// passed: `num_t = t·|det|`, `num_u = u·|det|`, `num_v = v·|det|` (already carrying the sign
+/// of `det`) and `den = |det| > 0`.
+///
+/// 1. The lower end on the unscaled value: `num_t > 0` (exact in sign) unless `t_min < 0` —
+///    2 cmp; a triangle behind the origin costs no division.
+/// 2. The upper end before dividing: `num_t < t_max·den` — 1 mul, 1 cmp. The product rounds,
+///    but the closest-hit loops relax `t_max` to `t + |t|·2^-21` after each hit and take a
+///    candidate only when its rounded `t` is below the best (see [`hit`](crate::hit)), so
+///    this never drops a hit that would win: only the hits that win so far reach step 3.
+/// 3. `t = num_t/den` (1 div), strictly inside `(t_min, t_max)` — 2 cmp. `u`, `v` stay
+///    unscaled with `den`: the loops divide them once per ray, for the winner.
+#[inline(always)]
+pub(crate) fn resolve<L: Lane>(
+    ray: &RayPacket<L>,
+    mask: L::Mask,
+    num_t: L,
+    num_u: L,
+    num_v: L,
+    den: L,
+) -> LaneHit<L> {
+    let zero = L::from_f32(0.0);
+    let mask = mask & (num_t.gt(zero) | ray.t_min.lt(zero));
+    if mask.none() {
+        return LaneHit::miss();
+    }
+    let mask = mask & num_t.lt(ray.t_max * den);
+    if mask.none() {
+        return LaneHit::miss();
+    }
+    let t = num_t / den;
+    let mask = mask & t.gt(ray.t_min) & t.lt(ray.t_max) & num_u.is_finite() & num_v.is_finite();
+    LaneHit::deferred(t, num_u, num_v, den, mask)
+}
+
+/// The hit of one ray on one triangle with kernel `K`, or `None`.
+#[inline]
+#[must_use]
+pub fn intersect<K: TriangleKernel>(ray: &Ray, tri: &Triangle, cull: Cull) -> Option<HitRecord> {
+    let r = RayPacket::<f32>::splat(ray);
+    let h = K::intersect(&r, &K::prepare(&r), &TrianglePacket::splat(tri), cull).normalized();
+    h.mask.then_some(HitRecord {
+        t: h.t,
+        u: h.u,
+        v: h.v,
+        index: 0,
+    })
+}
+
+/// Closest hit of ray lanes over a slice of triangles with kernel `K` (N rays × 1 triangle).
+#[inline]
+#[must_use]
+pub fn closest<K: TriangleKernel, L: Lane>(
+    rays: &RayPacket<L>,
+    tris: &[Triangle],
+    cull: Cull,
+) -> Hit<L> {
+    let pre = K::prepare(rays);
+    hit::closest(rays, tris, |r, t| {
+        Some(K::intersect(r, &pre, &TrianglePacket::splat(t), cull))
+    })
+}
+
+/// Lanes whose ray hits some triangle (occlusion), with kernel `K`.
+#[inline]
+#[must_use]
+pub fn any<K: TriangleKernel, L: Lane>(
+    rays: &RayPacket<L>,
+    tris: &[Triangle],
+    cull: Cull,
+) -> L::Mask {
+    let pre = K::prepare(rays);
+    hit::any(rays, tris, |r, t| {
+        Some(K::intersect(r, &pre, &TrianglePacket::splat(t), cull))
+    })
+}
+
+/// Every hit: calls `f(index, hit)` for each triangle that some lane hits.
+#[inline]
+pub fn all<K: TriangleKernel, L: Lane>(
+    rays: &RayPacket<L>,
+    tris: &[Triangle],
+    cull: Cull,
+    mut f: impl FnMut(u32, &LaneHit<L>),
+) {
+    let pre = K::prepare(rays);
+    for (i, t) in tris.iter().enumerate() {
+        let h = K::intersect(rays, &pre, &TrianglePacket::splat(t), cull);
+        if h.mask.any() {
+            f(i as u32, &h.normalized());
+        }
+    }
+}
+
+/// Closest hit of one ray over triangles packed in lanes (1 ray × N triangles); the index is
+/// the triangle's position in the slice that was packed.
+#[inline]
+#[must_use]
+pub fn closest_soa<K: TriangleKernel, L: Lane>(
+    ray: &Ray,
+    tris: &[TrianglePacket<L>],
+    cull: Cull,
+) -> Option<HitRecord> {
+    let pre = K::prepare(&RayPacket::<L>::splat(ray));
+    hit::closest_soa(ray, tris, |r, t| Some(K::intersect(r, &pre, t, cull)))
+}
+
+/// True when one ray hits some triangle packed in lanes.
+#[inline]
+#[must_use]
+pub fn any_soa<K: TriangleKernel, L: Lane>(
+    ray: &Ray,
+    tris: &[TrianglePacket<L>],
+    cull: Cull,
+) -> bool {
+    let pre = K::prepare(&RayPacket::<L>::splat(ray));
+    hit::any_soa(ray, tris, |r, t| Some(K::intersect(r, &pre, t, cull)))
+}
