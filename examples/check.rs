@@ -11,7 +11,7 @@
 //! prints one line per case, in file order: `miss` or the computed values (shortest round-trip
 //! decimals), or `n/a` where the method does not apply to the line's kind. With
 //! `--ignore-limits` every applicable case is compared, inside the method's limits or not
-//! (to see where a method fails).
+//! (to see where a method fails). `--list` prints the method names.
 
 use std::process::ExitCode;
 
@@ -44,6 +44,10 @@ fn main() -> ExitCode {
                 _ => return usage(),
             },
             "--emit" => emit = true,
+            "--list" => {
+                Method::ALL.iter().for_each(|m| println!("{}", m.name()));
+                return ExitCode::SUCCESS;
+            }
             "--ignore-limits" => ignore_limits = true,
             "-h" | "--help" => return usage(),
             f => files.push(f.to_string()),

@@ -9,25 +9,8 @@
 
 fn main() {
     let csv = std::env::args().any(|a| a == "--csv");
-    let rows = raylane::opcount::table();
-    if csv {
-        println!("kernel,path,mul,add,div,sqrt,cmp");
-        for r in &rows {
-            let c = r.counts;
-            println!(
-                "{},{},{},{},{},{},{}",
-                r.kernel, r.path, c.mul, c.add, c.div, c.sqrt, c.cmp
-            );
-        }
-        return;
-    }
-    println!("| kernel | path | mul | add | div | sqrt | cmp |");
-    println!("| --- | --- | ---: | ---: | ---: | ---: | ---: |");
-    for r in &rows {
-        let c = r.counts;
-        println!(
-            "| {} | {} | {} | {} | {} | {} | {} |",
-            r.kernel, r.path, c.mul, c.add, c.div, c.sqrt, c.cmp
-        );
-    }
+    let mut out = String::new();
+    raylane::opcount::write_report(&mut out, &raylane::opcount::table(), csv)
+        .expect("a String accepts any text");
+    print!("{out}");
 }

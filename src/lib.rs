@@ -65,6 +65,11 @@ pub mod vec3;
 #[cfg(feature = "vectors")]
 pub mod vectors;
 
+/// The README's examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+struct ReadmeDoctests;
+
 pub use camera::Pinhole;
 pub use hit::{Hit, HitRecord, LaneHit};
 pub use lane::{Lane, Mask};

@@ -447,3 +447,32 @@ pub fn table() -> [Row; 37] {
         row("bound", "per mesh", bound),
     ]
 }
+
+/// Writes the report as a Markdown table (the README's) or, with `csv`, as
+/// `kernel,path,mul,add,div,sqrt,cmp` lines with a header.
+pub fn write_report(out: &mut impl fmt::Write, rows: &[Row], csv: bool) -> fmt::Result {
+    if csv {
+        writeln!(out, "kernel,path,mul,add,div,sqrt,cmp")?;
+    } else {
+        writeln!(out, "| kernel | path | mul | add | div | sqrt | cmp |")?;
+        writeln!(out, "| --- | --- | ---: | ---: | ---: | ---: | ---: |")?;
+    }
+    for r in rows {
+        let c = r.counts;
+        let (k, p) = (r.kernel, r.path);
+        if csv {
+            writeln!(
+                out,
+                "{k},{p},{},{},{},{},{}",
+                c.mul, c.add, c.div, c.sqrt, c.cmp
+            )?;
+        } else {
+            writeln!(
+                out,
+                "| {k} | {p} | {} | {} | {} | {} | {} |",
+                c.mul, c.add, c.div, c.sqrt, c.cmp
+            )?;
+        }
+    }
+    Ok(())
+}

@@ -1,5 +1,11 @@
-//! Runs the focal benchmark loop once, guarded or unguarded, for instruction counting:
-//! `valgrind --tool=callgrind target/release/examples/focal_ir guarded 256`.
+//! Runs the focal benchmark loop `REPS` times, guarded or unguarded, for instruction counting:
+//!
+//! ```text
+//! cargo build --release -p raylane-bench --example focal_ir
+//! valgrind --tool=callgrind target/release/examples/focal_ir guarded 256 4   # (N, REPS)
+//! ```
+//!
+//! Instructions per packet test = (count at REPS − count at 0) / REPS / (1536 packets · N).
 use raylane::Ray8;
 use raylane::sphere::FocalSphere;
 use raylane::sphere::focal::{self, Focal, FocalUnguarded};

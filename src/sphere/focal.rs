@@ -185,7 +185,7 @@ impl FocalSphere<f32> {
         };
         // Step 3. Accuracy of t = v ∓ √(r² − l²) on a certain hit: |t_c − t| ≤ err = rest + E_X/√X,
         // with rest = α + (2u+η)(c+r) and E_X the error of X = r² − l². Every root of a ray from
-        // outside has |t| ≥ c − r, so aim for err = 2^-16·|c − r|/2 (at least 2·rest) and accept
+        // outside has |t| ≥ c − r, so aim for err = 0.98·2^-16·|c − r| (at least 2·rest) and accept
         // only X ≥ X_min = (E_X/(err − rest))² (l² ≤ l2_acc). A root is then within 2^-16 of the
         // exact one when |t_c| ≥ t_acc = err/2^-16 + err — true for every root of a ray from
         // outside; one compare per root, per lane, catches the rest.
@@ -194,7 +194,7 @@ impl FocalSphere<f32> {
         let e_l2 = a2 + 2.0 * wp * (r + a) + wp * wp + g3 * sq(r + a + wp);
         let e_x = 1.01 * e_l2 + 2.01 * U * r2e;
         let rest = alpha + 1.01 * (2.0 * U + ETA) * (c + r) * n1;
-        let err = (0.5 * EPS_T * (c - r).abs()).max(2.0 * rest);
+        let err = (0.98 * EPS_T * (c - r).abs()).max(2.0 * rest);
         let x_min = sq(e_x / (err - rest));
         let l2_acc = r2e * (1.0 - U) - x_min - e_x;
         let err = err * (1.0 + F64_REL);
@@ -276,8 +276,10 @@ pub trait FocalLanes<L: Lane> {
     fn t(&self) -> V3<L>;
     /// The cheap test's threshold in lanes.
     fn k_lo(&self) -> L;
-    /// Every field in lanes (for the hit path).
-    fn lanes(&self) -> FocalSphere<L>;
+    /// The hit path's thresholds: `(r², l2_hit, l2_miss, t_acc)`.
+    fn guard(&self) -> (L, L, L, L);
+    /// The spheres, for the `f64` fallback.
+    fn sphere(&self) -> SpherePacket<L>;
 }
 
 impl<L: Lane> FocalLanes<L> for FocalSphere<L> {
@@ -290,8 +292,15 @@ impl<L: Lane> FocalLanes<L> for FocalSphere<L> {
         self.k_lo
     }
     #[inline(always)]
-    fn lanes(&self) -> FocalSphere<L> {
-        *self
+    fn guard(&self) -> (L, L, L, L) {
+        (self.r2, self.l2_hit, self.l2_miss, self.t_acc)
+    }
+    #[inline(always)]
+    fn sphere(&self) -> SpherePacket<L> {
+        SpherePacket {
+            center: self.center,
+            radius: self.radius,
+        }
     }
 }
 
@@ -309,8 +318,21 @@ impl<L: Lane> FocalLanes<L> for Splat<'_> {
         L::from_f32(self.0.k_lo)
     }
     #[inline(always)]
-    fn lanes(&self) -> FocalSphere<L> {
-        FocalSphere::splat(self.0)
+    fn guard(&self) -> (L, L, L, L) {
+        let e = self.0;
+        (
+            L::from_f32(e.r2),
+            L::from_f32(e.l2_hit),
+            L::from_f32(e.l2_miss),
+            L::from_f32(e.t_acc),
+        )
+    }
+    #[inline(always)]
+    fn sphere(&self) -> SpherePacket<L> {
+        SpherePacket {
+            center: V3::splat(self.0.center.into()),
+            radius: L::from_f32(self.0.radius),
+        }
     }
 }
 
@@ -396,35 +418,42 @@ fn focal<L: Lane, S: FocalLanes<L>, const GUARDED: bool>(
         return Some(Roots::in_interval(ray, v - d, v + d, maybe));
     }
     // 2.–4. Reading the rest of the entry only now.
-    Some(hit_path(ray, &s.lanes(), v, maybe))
+    Some(hit_path(ray, s, v, maybe))
 }
 
 /// Steps 2–4 of the guarded test, for lanes that passed the cheap test (`maybe`).
 #[inline(always)]
-fn hit_path<L: Lane>(ray: &RayPacket<L>, s: &FocalSphere<L>, v: L, maybe: L::Mask) -> Roots<L> {
+fn hit_path<L: Lane, S: FocalLanes<L>>(
+    ray: &RayPacket<L>,
+    s: &S,
+    v: L,
+    maybe: L::Mask,
+) -> Roots<L> {
+    let (r2, l2_hit, l2_miss, t_acc) = s.guard();
     // 2. Perpendicular from the centre to the ray: p = T − vU, l² = p·p.
-    let l2 = (s.t - ray.dir.scale(v)).length_squared();
-    let sure_miss = l2.ge(s.l2_miss);
+    let l2 = (s.t() - ray.dir.scale(v)).length_squared();
+    let sure_miss = l2.ge(l2_miss);
     // 3. Half chord and both roots; a certain hit needs l² ≤ l2_hit and both roots far enough
     //    from zero for their error bound to be within 2^-16 of them.
-    let d = (s.r2 - l2).sqrt();
+    let d = (r2 - l2).sqrt();
     let (t0, t1) = (v - d, v + d);
-    let sure_hit = maybe & l2.le(s.l2_hit) & t0.abs().ge(s.t_acc) & t1.abs().ge(s.t_acc);
+    let sure_hit = maybe & l2.le(l2_hit) & t0.abs().ge(t_acc) & t1.abs().ge(t_acc);
     let roots = Roots::in_interval(ray, t0, t1, sure_hit);
     // 4. Lanes the guard cannot decide: the robust body in f64, one lane at a time.
     let doubtful = maybe.and_not(sure_hit | sure_miss);
     if doubtful.none() {
         roots
     } else {
-        precise(ray, &s.sphere(), roots, doubtful)
+        precise(*ray, s.sphere(), roots, doubtful)
     }
 }
 
-/// Recomputes the `doubtful` lanes with [`Robust`] in `L::Precise` (`f64`).
+/// Recomputes the `doubtful` lanes with [`Robust`] in `L::Precise` (`f64`). Out of line and
+/// taking its inputs by value, so the callers' ray packets never need an address.
 #[inline(never)]
 fn precise<L: Lane>(
-    ray: &RayPacket<L>,
-    s: &SpherePacket<L>,
+    ray: RayPacket<L>,
+    s: SpherePacket<L>,
     mut roots: Roots<L>,
     doubtful: L::Mask,
 ) -> Roots<L> {
@@ -432,7 +461,7 @@ fn precise<L: Lane>(
     while bits != 0 {
         let i = bits.trailing_zeros() as usize;
         let p = Robust::roots(&ray.precise_lane(i), &s.precise_lane(i));
-        roots = roots.with_precise_lane(i, ray, &p);
+        roots = roots.with_precise_lane(i, ray.t_min.lane(i), ray.t_max.lane(i), &p);
         bits &= bits - 1;
     }
     roots

@@ -235,16 +235,16 @@ impl<L: Lane> Roots<L> {
     }
 
     /// Replaces lane `i` with roots computed elsewhere (a higher-precision fallback), rounding
-    /// them to the lane's precision and re-checking them against the ray's interval.
-    #[inline(never)]
+    /// them to the lane's precision and re-checking them against the lane's interval.
+    #[inline(always)]
     #[must_use]
     pub(crate) fn with_precise_lane(
         self,
         i: usize,
-        ray: &RayPacket<L>,
+        t_min: L::Scalar,
+        t_max: L::Scalar,
         p: &Roots<L::Precise>,
     ) -> Self {
-        let (t_min, t_max) = (ray.t_min.lane(i), ray.t_max.lane(i));
         let fit = |t: f64, m: bool| {
             let t = L::Scalar::from_f64(t);
             (m && t > t_min && t < t_max).then_some(t)
