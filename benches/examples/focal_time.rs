@@ -10,9 +10,7 @@ use raylane_bench::sphere_scene;
 
 fn main() {
     for n in [16usize, 64, 256] {
-        let (cam, spheres) = sphere_scene(n, 7, 128, 96);)
-                .collect();
-        }
+        let (cam, spheres) = sphere_scene(n, 7, 128, 96);
         let packets: Vec<Ray8> = (0..cam.height)
             .flat_map(|y| (0..cam.width).step_by(8).map(move |x| (x, y)))
             .map(|(x, y)| cam.row_packet(x, y))
