@@ -83,7 +83,7 @@ pub fn ritter_indexed(positions: &[Vec3], indices: &[[u32; 3]]) -> Option<Sphere
         indices
             .iter()
             .filter(|t| t.iter().all(|&i| (i as usize) < positions.len()))
-            .flat_map(|t| t.iter().map(|&i| positions[i as usize]))
+            .flat_map(|t| t.iter().filter_map(|&i| positions.get(i as usize).copied()))
     })
 }
 

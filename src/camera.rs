@@ -30,6 +30,18 @@ pub struct Pinhole {
     pub height: u32,
 }
 
+/// `v / |v|` with the crate's square root (`vsqrt.f32` on Cortex-M, not glam's software
+/// `libm` root), or zero for a zero or non-finite vector.
+fn unit(v: Vec3) -> Vec3 {
+    let w = V3::<f32>::from(v);
+    let n = w.length_squared().sqrt();
+    if n > 0.0 && n.is_finite() {
+        w.div_by(n).into()
+    } else {
+        Vec3::ZERO
+    }
+}
+
 impl Pinhole {
     /// A camera at `eye` looking at `target`, with `up` roughly up, a vertical field of view
     /// of `vfov_degrees`, and an image of `width × height` pixels (square pixels).
@@ -42,8 +54,8 @@ impl Pinhole {
         width: u32,
         height: u32,
     ) -> Self {
-        let forward = (target - eye).normalize_or_zero();
-        let right = forward.cross(up).normalize_or_zero();
+        let forward = unit(target - eye);
+        let right = unit(forward.cross(up));
         let down = forward.cross(right);
         let half_h = libm::tanf(vfov_degrees.to_radians() * 0.5);
         let pixel = 2.0 * half_h / height.max(1) as f32;

@@ -265,7 +265,7 @@ pub fn closest_filtered<L: Lane, P>(
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            if let Some(h) = test(&r, &block[j]) {
+            if let Some(h) = block.get(j).and_then(|p| test(&r, p)) {
                 let take = closer(&h, &best);
                 if take.any() {
                     best.take(&h, take, (b * 64 + j) as u32);
@@ -295,7 +295,7 @@ pub fn any_filtered<L: Lane, P>(
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            if let Some(h) = test(rays, &block[j]) {
+            if let Some(h) = block.get(j).and_then(|p| test(rays, p)) {
                 hit = hit | h.mask;
                 if valid.and_not(hit).none() {
                     return hit & valid;

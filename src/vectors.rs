@@ -136,6 +136,18 @@ pub struct Case {
     pub line: u32,
 }
 
+impl Default for Case {
+    /// A placeholder (a plane case expecting a miss), for filling buffers.
+    fn default() -> Self {
+        Case {
+            kind: Kind::Plane,
+            input: [0.0; 15],
+            expect: Values::MISS,
+            line: 0,
+        }
+    }
+}
+
 impl Case {
     /// Ray origin.
     #[must_use]
@@ -786,4 +798,56 @@ mod tests {
             .unwrap();
         assert!(nan.input[0].is_nan() && nan.input[6].is_infinite());
     }
+}
+
+/// The lane widths every method is run at.
+pub const LANE_WIDTHS: [usize; 4] = [1, 4, 8, 16];
+
+/// Counts of one method over some cases.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Tally {
+    /// Inside the method's limits and matching.
+    pub passed: usize,
+    /// Inside the method's limits and not matching.
+    pub failed: usize,
+    /// Outside the method's limits, or of a kind it does not test.
+    pub skipped: usize,
+}
+
+/// Evaluates `cases` with `method` at `lanes` lanes, compares every outcome with its
+/// expectation, and folds the outcomes into `digest` in order. `out` is scratch space of at
+/// least `cases.len()` outcomes. The checker's core, shared by the host digests and the
+/// firmware; returns `None` for an unsupported width or too small a buffer.
+pub fn check(
+    method: Method,
+    lanes: usize,
+    cases: &[Case],
+    out: &mut [Outcome],
+    digest: &mut Digest,
+) -> Option<Tally> {
+    if !evaluate(method, lanes, cases, out) {
+        return None;
+    }
+    let mut t = Tally::default();
+    for (c, o) in cases.iter().zip(out.iter()) {
+        digest.update(o);
+        match compare(method, c, o) {
+            Verdict::Pass => t.passed += 1,
+            Verdict::Fail => t.failed += 1,
+            Verdict::Skip(_) => t.skipped += 1,
+        }
+    }
+    Some(t)
+}
+
+/// Parses a file's text into `buf`; returns the number of cases, or the first bad line.
+pub fn load(text: &str, buf: &mut [Case]) -> Result<usize, (u32, ParseError)> {
+    let mut n = 0;
+    for (line, r) in cases(text) {
+        let c = r.map_err(|e| (line, e))?;
+        let slot = buf.get_mut(n).ok_or((line, ParseError::InputCount))?;
+        *slot = c;
+        n += 1;
+    }
+    Ok(n)
 }

@@ -45,16 +45,23 @@ impl Expansion {
     pub(crate) fn add(&mut self, b: f64) {
         let mut q = b;
         let mut m = 0;
+        // In place: component i is read before slot m <= i is written. `get` keeps every
+        // access in bounds without a panic path (at most 12 components are ever used).
         for i in 0..self.n {
-            let (s, h) = two_sum(q, self.e[i]);
+            let Some(&e) = self.e.get(i) else { break };
+            let (s, h) = two_sum(q, e);
             if h != 0.0 {
-                self.e[m] = h;
+                if let Some(slot) = self.e.get_mut(m) {
+                    *slot = h;
+                }
                 m += 1;
             }
             q = s;
         }
-        if q != 0.0 && m < self.e.len() {
-            self.e[m] = q;
+        if q != 0.0
+            && let Some(slot) = self.e.get_mut(m)
+        {
+            *slot = q;
             m += 1;
         }
         self.n = m;
@@ -69,16 +76,16 @@ impl Expansion {
 
     /// Sign of the exact sum: -1, 0 or 1.
     pub(crate) fn sign(&self) -> i32 {
-        match self.n {
-            0 => 0,
-            n if self.e[n - 1] > 0.0 => 1,
-            _ => -1,
+        match self.n.checked_sub(1).and_then(|top| self.e.get(top)) {
+            None => 0,
+            Some(&x) if x > 0.0 => 1,
+            Some(_) => -1,
         }
     }
 
     /// The sum rounded (to within a few `f64` ulps; the sign is exact).
     pub(crate) fn approx(&self) -> f64 {
-        self.e[..self.n].iter().sum()
+        self.e.iter().take(self.n).sum()
     }
 }
 
@@ -132,33 +139,42 @@ pub(crate) fn sos_sign(a: [f64; 3], b: [f64; 3]) -> i32 {
 /// every component of `(b − a) × (c − a)` is exactly zero. A cheap `f64` evaluation with an
 /// error bound settles almost every triangle; the rest get the exact expansion.
 pub(crate) fn collinear(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> bool {
+    // The three components, as (a_j, a_k, b_j, b_k, c_j, c_k) for (j, k) = (y, z), (z, x), (x, y).
+    let [ax, ay, az] = a;
+    let [bx, by, bz] = b;
+    let [cx, cy, cz] = c;
+    [
+        (ay, az, by, bz, cy, cz),
+        (az, ax, bz, bx, cz, cx),
+        (ax, ay, bx, by, cx, cy),
+    ]
+    .into_iter()
+    .all(|(aj, ak, bj, bk, cj, ck)| component_is_zero(aj, ak, bj, bk, cj, ck))
+}
+
+/// True when `(b_j − a_j)(c_k − a_k) − (b_k − a_k)(c_j − a_j)` is exactly zero.
+fn component_is_zero(aj: f64, ak: f64, bj: f64, bk: f64, cj: f64, ck: f64) -> bool {
     const TOL: f64 = 8.0 / 9_007_199_254_740_992.0; // 8·2^-53
-    for (j, k) in [(1, 2), (2, 0), (0, 1)] {
-        // (b_j − a_j)(c_k − a_k) − (b_k − a_k)(c_j − a_j)
-        let (p, q) = (b[j] - a[j], c[k] - a[k]);
-        let (r, s) = (b[k] - a[k], c[j] - a[j]);
-        let approx = p * q - r * s;
-        if approx.abs() > TOL * ((p * q).abs() + (r * s).abs()) {
-            return false;
-        }
-        // Exactly: b_j c_k − b_j a_k − a_j c_k − b_k c_j + b_k a_j + a_k c_j (the a_j a_k
-        // terms cancel).
-        let mut x = Expansion::new();
-        for t in [
-            b[j] * c[k],
-            -(b[j] * a[k]),
-            -(a[j] * c[k]),
-            -(b[k] * c[j]),
-            b[k] * a[j],
-            a[k] * c[j],
-        ] {
-            x.add(t);
-        }
-        if x.sign() != 0 {
-            return false;
-        }
+    let (p, q) = (bj - aj, ck - ak);
+    let (r, s) = (bk - ak, cj - aj);
+    let approx = p * q - r * s;
+    if approx.abs() > TOL * ((p * q).abs() + (r * s).abs()) {
+        return false;
     }
-    true
+    // Exactly: b_j c_k − b_j a_k − a_j c_k − b_k c_j + b_k a_j + a_k c_j (the a_j a_k terms
+    // cancel).
+    let mut x = Expansion::new();
+    for t in [
+        bj * ck,
+        -(bj * ak),
+        -(aj * ck),
+        -(bk * cj),
+        bk * aj,
+        ak * cj,
+    ] {
+        x.add(t);
+    }
+    x.sign() == 0
 }
 
 #[cfg(test)]

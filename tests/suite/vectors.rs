@@ -4,23 +4,35 @@
 use raylane::vectors::{self, Case, Digest, Kind, Method, Outcome, Verdict};
 
 const FILES: &[(&str, &str)] = &[
-    ("sphere_lecture", include_str!("vectors/sphere_lecture.txt")),
-    ("sphere_random", include_str!("vectors/sphere_random.txt")),
-    ("sphere_far", include_str!("vectors/sphere_far.txt")),
-    ("sphere_ground", include_str!("vectors/sphere_ground.txt")),
-    ("sphere_special", include_str!("vectors/sphere_special.txt")),
-    ("sphere_bad", include_str!("vectors/sphere_bad.txt")),
-    ("plane_random", include_str!("vectors/plane_random.txt")),
-    ("plane_bad", include_str!("vectors/plane_bad.txt")),
+    (
+        "sphere_lecture",
+        include_str!("../vectors/sphere_lecture.txt"),
+    ),
+    (
+        "sphere_random",
+        include_str!("../vectors/sphere_random.txt"),
+    ),
+    ("sphere_far", include_str!("../vectors/sphere_far.txt")),
+    (
+        "sphere_ground",
+        include_str!("../vectors/sphere_ground.txt"),
+    ),
+    (
+        "sphere_special",
+        include_str!("../vectors/sphere_special.txt"),
+    ),
+    ("sphere_bad", include_str!("../vectors/sphere_bad.txt")),
+    ("plane_random", include_str!("../vectors/plane_random.txt")),
+    ("plane_bad", include_str!("../vectors/plane_bad.txt")),
     (
         "triangle_random",
-        include_str!("vectors/triangle_random.txt"),
+        include_str!("../vectors/triangle_random.txt"),
     ),
     (
         "triangle_special",
-        include_str!("vectors/triangle_special.txt"),
+        include_str!("../vectors/triangle_special.txt"),
     ),
-    ("triangle_bad", include_str!("vectors/triangle_bad.txt")),
+    ("triangle_bad", include_str!("../vectors/triangle_bad.txt")),
 ];
 
 fn load(text: &str) -> Vec<Case> {

@@ -2,7 +2,7 @@
 
 #[test]
 fn readme_op_count_table_is_the_report() {
-    let readme = include_str!("../README.md");
+    let readme = include_str!("../../README.md");
     let begin = "<!-- opcount:begin -->\n";
     let end = "<!-- opcount:end -->";
     let start = readme

@@ -260,7 +260,8 @@ fn targets(s: &Shape, rng: &mut SmallRng) -> Vec<(Vec3, Target)> {
     }
     for t in &s.idx {
         let [a, b, c] = t.map(|i| s.pos[i as usize]);
-        for _ in 0..2 {
+        // One random interior point per triangle: the control group (no method leaks there).
+        for _ in 0..1 {
             let (u, v) = (rng.random_range(0.0..1.0f32), rng.random_range(0.0..1.0f32));
             let (u, v) = if u + v > 1.0 {
                 (1.0 - u, 1.0 - v)

@@ -1,0 +1,111 @@
+//! Shared by the firmware binaries: a function that calls every kernel of raylane at one lane
+//! width (every formulation and entry point), with inputs from volatile reads and results to a
+//! volatile sink so nothing is folded away.
+#![no_std]
+
+use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
+
+use glam::Vec3;
+use raylane::mesh::Mesh;
+use raylane::plane::{self, FocalPlane, Plane};
+use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
+use raylane::sphere::{
+    self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere, SpherePacket,
+};
+use raylane::triangle::{
+    self, Cramer, Cull, FocalRays, FocalTriangle, Moller, Triangle, TrianglePacket, Watertight,
+};
+use raylane::{Hit, Lane, Mask, Ray, RayPacket};
+
+static INPUT: [f32; 16] = [
+    0.0, 1.0, 2.0, -1.0, 0.5, 5.0, 3.0, -10.0, 0.25, 4.0, 0.1, -0.3, 7.0, 1.5, -2.0, 0.75,
+];
+static mut SINK: u32 = 0;
+
+pub fn x(i: usize) -> f32 {
+    // SAFETY: a read of an initialised static.
+    unsafe { read_volatile(addr_of!(INPUT[i % 16])) }
+}
+
+pub fn v(i: usize) -> Vec3 {
+    Vec3::new(x(i), x(i + 1), x(i + 2))
+}
+
+fn sink(bits: u32) {
+    // SAFETY: single-threaded firmware; volatile so the result counts as used.
+    unsafe { write_volatile(addr_of_mut!(SINK), read_volatile(addr_of!(SINK)) ^ bits) }
+}
+
+fn hits<L: Lane<Scalar = f32>>(h: &Hit<L>) {
+    sink(h.mask.bits() ^ h.t.lane(0).to_bits() ^ h.u.lane(0).to_bits());
+}
+
+fn rec(r: Option<raylane::HitRecord>) {
+    sink(r.map_or(7, |h| h.t.to_bits() ^ h.index));
+}
+
+pub fn every_kernel<L: Lane<Scalar = f32>>(rays: &RayPacket<L>, ray: &Ray) {
+    let balls = [
+        Sphere::new(v(5), x(6)),
+        Sphere::new(v(0), x(4)),
+        Sphere::new(v(8), x(9)),
+    ];
+    let eye = ray.origin();
+    // Spheres: every formulation, N rays × 1 sphere and 1 ray × N spheres.
+    hits(&sphere::closest::<Quadratic, L>(rays, &balls));
+    hits(&sphere::closest::<QuadraticUnit, L>(rays, &balls));
+    hits(&sphere::closest::<Geometric, L>(rays, &balls));
+    hits(&sphere::closest::<Robust, L>(rays, &balls));
+    sink(sphere::any::<Robust, L>(rays, &balls).bits());
+    sphere::all::<Robust, L>(rays, &balls, |i, r| sink(i ^ r.any().bits()));
+    let mut packed = [SpherePacket::<L>::from_spheres(&[]); 1];
+    SpherePacket::pack(&balls, &mut packed);
+    rec(sphere::closest_soa::<Robust, L>(ray, &packed));
+    rec(sphere::intersect::<Robust>(ray, &balls[0]));
+    // Focal spheres, guarded and not.
+    let mut cache = [FocalSphere::new(eye, &balls[0]); 3];
+    sf::focus(eye, &balls, &mut cache);
+    hits(&sf::closest::<Focal, L>(rays, &cache));
+    sink(sf::any::<Focal, L>(rays, &cache).bits());
+    let unguarded = [FocalSphere::unguarded(eye, &balls[1])];
+    hits(&sf::closest::<FocalUnguarded, L>(rays, &unguarded));
+    let mut fpacked = [FocalSphere::<L>::gather(&[]); 1];
+    FocalSphere::pack(&cache, &mut fpacked);
+    rec(sf::closest_soa::<Focal, L>(ray, &fpacked));
+    // Planes.
+    let walls = [Plane::new(v(3), v(7)), Plane::new(v(1), v(2))];
+    hits(&plane::closest::<L>(rays, &walls));
+    hits(&plane::closest_focal::<L>(
+        rays,
+        &[FocalPlane::new(eye, &walls[0])],
+    ));
+    // Triangles: every formulation, packets of rays and of triangles, meshes and caches.
+    let tris = [
+        Triangle::new(v(0), v(3), v(6)),
+        Triangle::new(v(2), v(9), v(12)),
+    ];
+    hits(&triangle::closest::<Cramer, L>(rays, &tris, Cull::None));
+    hits(&triangle::closest::<Moller, L>(rays, &tris, Cull::Back));
+    hits(&triangle::closest::<Watertight, L>(rays, &tris, Cull::None));
+    sink(triangle::any::<Watertight, L>(rays, &tris, Cull::None).bits());
+    triangle::all::<Moller, L>(rays, &tris, Cull::None, |i, h| sink(i ^ h.mask.bits()));
+    let mut tpacked = [TrianglePacket::<L>::from_triangles(&[]); 1];
+    TrianglePacket::pack(&tris, &mut tpacked);
+    rec(triangle::closest_soa::<Watertight, L>(
+        ray,
+        &tpacked,
+        Cull::None,
+    ));
+    let mut tcache = [FocalTriangle::never(); 2];
+    triangle::focal::focus(eye, &tris, &mut tcache);
+    hits(&triangle::focal::closest(rays, &tcache, Cull::None));
+    sink(triangle::focal::any(rays, &tcache, Cull::None).bits());
+    let positions = [v(0), v(3), v(6), v(9)];
+    let indices = [[0u32, 1, 2], [1, 3, 2], [0, 3, 9]];
+    let mesh = Mesh::bounded(&positions, &indices);
+    hits(&mesh.closest::<Watertight, L>(rays, Cull::None));
+    sink(mesh.any::<Moller, L>(rays, Cull::None).bits());
+    let mut mcache = [FocalTriangle::never(); 3];
+    let fm = mesh.focus(eye, &mut mcache);
+    hits(&fm.closest(&FocalRays::new(rays), Cull::None));
+}

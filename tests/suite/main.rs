@@ -1,0 +1,12 @@
+//! The host test suite, as one test binary (every kernel is monomorphised once for all tests,
+//! which keeps builds quick for each CPU configuration and for the AArch64 run).
+
+mod bad_input;
+mod focal_precision;
+mod lanes;
+mod opcount;
+mod readme;
+mod triangles;
+#[cfg(feature = "vectors")]
+mod vectors;
+mod watertight;
