@@ -304,7 +304,7 @@ impl<'c> FocalMesh<'c> {
     pub fn any<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> L::Mask {
         match self.culled(rays) {
             Some(r) => hit::any(&r.scaled, self.cache, |r, e| {
-                Some(tf::kernel(r, &FocalTriangle::splat(e), cull))
+                tf::maybe_hit(r, &tf::Splat(e), cull)
             }),
             None => Mask::splat(false),
         }

@@ -247,6 +247,78 @@ impl<L: Lane> FocalTriangle<L> {
     }
 }
 
+/// Where the kernel reads its cached triangle lanes from: a [`FocalTriangle<L>`] already in
+/// lanes (1 ray × N triangles), or a [`Splat`] of one entry (N rays × 1 triangle) that
+/// broadcasts only what each step needs, so a miss reads the edge normals and bounds alone and
+/// the exact fallback reads the scalar entry (no splatted copy of the whole entry is built).
+pub(crate) trait FocalTriangleLanes<L: Lane> {
+    /// `n_ab`, `n_bc`, `n_ca` in lanes.
+    fn normals(&self) -> (V3<L>, V3<L>, V3<L>);
+    /// `k_ab`, `k_bc`, `k_ca` in lanes.
+    fn bounds(&self) -> (L, L, L);
+    /// `V` in lanes.
+    fn v(&self) -> L;
+    /// `A′`, `B′`, `C′` of lane `i` in `f64` (exact), for the exact fallback.
+    fn vertices(&self, i: usize) -> [[f64; 3]; 3];
+}
+
+impl<L: Lane> FocalTriangleLanes<L> for FocalTriangle<L> {
+    #[inline(always)]
+    fn normals(&self) -> (V3<L>, V3<L>, V3<L>) {
+        (self.n_ab, self.n_bc, self.n_ca)
+    }
+    #[inline(always)]
+    fn bounds(&self) -> (L, L, L) {
+        (self.k_ab, self.k_bc, self.k_ca)
+    }
+    #[inline(always)]
+    fn v(&self) -> L {
+        self.v
+    }
+    #[inline(always)]
+    fn vertices(&self, i: usize) -> [[f64; 3]; 3] {
+        let w = |v: V3<L>| {
+            [
+                v.x.lane(i).to_f64(),
+                v.y.lane(i).to_f64(),
+                v.z.lane(i).to_f64(),
+            ]
+        };
+        [w(self.a), w(self.b), w(self.c)]
+    }
+}
+
+/// One cache entry seen in every lane, broadcast lazily (see [`FocalTriangleLanes`]).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Splat<'a>(pub(crate) &'a FocalTriangle<f32>);
+
+impl<L: Lane> FocalTriangleLanes<L> for Splat<'_> {
+    #[inline(always)]
+    fn normals(&self) -> (V3<L>, V3<L>, V3<L>) {
+        let e = self.0;
+        let v = |x: V3<f32>| V3::splat(x.into());
+        (v(e.n_ab), v(e.n_bc), v(e.n_ca))
+    }
+    #[inline(always)]
+    fn bounds(&self) -> (L, L, L) {
+        let e = self.0;
+        (
+            L::from_f32(e.k_ab),
+            L::from_f32(e.k_bc),
+            L::from_f32(e.k_ca),
+        )
+    }
+    #[inline(always)]
+    fn v(&self) -> L {
+        L::from_f32(self.0.v)
+    }
+    #[inline(always)]
+    fn vertices(&self, _i: usize) -> [[f64; 3]; 3] {
+        let e = self.0;
+        [wide(e.a), wide(e.b), wide(e.c)]
+    }
+}
+
 /// Builds the cache of `tris` for rays from `eye` into `out` (no allocation); returns the
 /// number of entries written (`min(tris.len(), out.len())`).
 pub fn focus(eye: Vec3, tris: &[Triangle], out: &mut [FocalTriangle<f32>]) -> usize {
@@ -360,23 +432,97 @@ impl<L: Lane> FocalRays<L> {
 /// [module docs](self).
 #[inline(always)]
 #[must_use]
-pub(crate) fn kernel<L: Lane>(ray: &RayPacket<L>, f: &FocalTriangle<L>, cull: Cull) -> LaneHit<L> {
-    let d = ray.dir;
-    // 1. Edge values: the direction against the three cached edge-plane normals.
-    let e_ab = d.dot(f.n_ab);
-    let e_bc = d.dot(f.n_bc);
-    let e_ca = d.dot(f.n_ca);
-    // 2. Signs beyond the rounding bound are exact: all negative is a front face, all positive
-    //    a back face.
-    let (p_ab, n_ab) = (e_ab.gt(f.k_ab), e_ab.lt(-f.k_ab));
-    let (p_bc, n_bc) = (e_bc.gt(f.k_bc), e_bc.lt(-f.k_bc));
-    let (p_ca, n_ca) = (e_ca.gt(f.k_ca), e_ca.lt(-f.k_ca));
+pub(crate) fn kernel<L: Lane, F: FocalTriangleLanes<L>>(
+    ray: &RayPacket<L>,
+    f: &F,
+    cull: Cull,
+) -> LaneHit<L> {
+    maybe_hit(ray, f, cull).unwrap_or_else(LaneHit::miss)
+}
+
+/// Steps 1 and 2 of the test: the edge values and their signs where they are certain.
+struct Edges<L: Lane> {
+    e: [L; 3],
+    /// Certainly positive (`e > K`).
+    pos: [L::Mask; 3],
+    /// Certainly negative (`e < −K`).
+    neg: [L::Mask; 3],
+}
+
+impl<L: Lane> Edges<L> {
+    #[inline(always)]
+    fn new<F: FocalTriangleLanes<L>>(ray: &RayPacket<L>, f: &F) -> Self {
+        let d = ray.dir;
+        // 1. Edge values: the direction against the three cached edge-plane normals.
+        let (na, nb, nc) = f.normals();
+        let e = [d.dot(na), d.dot(nb), d.dot(nc)];
+        // 2. Signs beyond the rounding bound are exact.
+        let (k_ab, k_bc, k_ca) = f.bounds();
+        let k = [k_ab, k_bc, k_ca];
+        Edges {
+            e,
+            pos: [e[0].gt(k[0]), e[1].gt(k[1]), e[2].gt(k[2])],
+            neg: [e[0].lt(-k[0]), e[1].lt(-k[1]), e[2].lt(-k[2])],
+        }
+    }
+
+    /// Some edge is certainly positive / certainly negative.
+    #[inline(always)]
+    fn any(&self) -> (L::Mask, L::Mask) {
+        let [p0, p1, p2] = self.pos;
+        let [n0, n1, n2] = self.neg;
+        (p0 | p1 | p2, n0 | n1 | n2)
+    }
+
+    /// True when every lane certainly misses: it has a certainly positive and a certainly
+    /// negative edge (with back faces culled, a certainly positive edge suffices).
+    #[inline(always)]
+    fn all_out(&self, cull: Cull) -> bool {
+        let (any_p, any_n) = self.any();
+        let out = if cull.back() { any_p } else { any_p & any_n };
+        out.all()
+    }
+}
+
+/// False when every lane certainly misses ([`maybe_hit`] then returns `None`): the first pass
+/// of the closest-hit loop, with no calls, so the rays stay in registers.
+#[inline(always)]
+#[must_use]
+pub(crate) fn candidate<L: Lane, F: FocalTriangleLanes<L>>(
+    ray: &RayPacket<L>,
+    f: &F,
+    cull: Cull,
+) -> bool {
+    !Edges::new(ray, f).all_out(cull)
+}
+
+/// [`kernel`], or `None` when no lane hits: the miss paths end before any record is built, and
+/// the closest/any loops skip their merge.
+#[inline(always)]
+#[must_use]
+pub(crate) fn maybe_hit<L: Lane, F: FocalTriangleLanes<L>>(
+    ray: &RayPacket<L>,
+    f: &F,
+    cull: Cull,
+) -> Option<LaneHit<L>> {
+    // 1.–2. Edge values and their certain signs; stop when every lane certainly misses.
+    let edges = Edges::new(ray, f);
+    if edges.all_out(cull) {
+        return None;
+    }
+    let Edges {
+        e: [e_ab, e_bc, e_ca],
+        pos: [p_ab, p_bc, p_ca],
+        neg: [n_ab, n_bc, n_ca],
+    } = edges;
+    let (any_p, any_n) = edges.any();
+    // All negative is a front face, all positive a back face.
     let mut front = n_ab & n_bc & n_ca;
     let mut back = p_ab & p_bc & p_ca;
     // 3. Lanes where a sign in doubt could complete a pattern: decide those signs exactly.
     let finite = e_ab.is_finite() & e_bc.is_finite() & e_ca.is_finite();
-    let maybe_front = !(p_ab | p_bc | p_ca);
-    let maybe_back = !(n_ab | n_bc | n_ca);
+    let maybe_front = !any_p;
+    let maybe_back = !any_n;
     let mut doubtful = maybe_front.and_not(front);
     if !cull.back() {
         doubtful = doubtful | maybe_back.and_not(back);
@@ -388,19 +534,20 @@ pub(crate) fn kernel<L: Lane>(ray: &RayPacket<L>, f: &FocalTriangle<L>, cull: Cu
     }
     let mask = if cull.back() { front } else { front | back };
     if mask.none() {
-        return LaneHit::miss();
+        return None;
     }
     // 4. |det| = Σ|e| and ±V with the sign of det; the interval, then the one division.
     let (x_ab, x_ca) = (e_ab.abs(), e_ca.abs());
     let ad = x_ab + e_bc.abs() + x_ca;
-    resolve(ray, mask, L::select(front, -f.v, f.v), x_ca, x_ab, ad)
+    let v = f.v();
+    Some(resolve(ray, mask, L::select(front, -v, v), x_ca, x_ab, ad))
 }
 
 /// Decides the `doubtful` lanes with exact edge signs (simulation of simplicity for zeros).
 #[inline(never)]
-fn exact_signs<L: Lane>(
+fn exact_signs<L: Lane, F: FocalTriangleLanes<L>>(
     ray: &RayPacket<L>,
-    f: &FocalTriangle<L>,
+    f: &F,
     doubtful: L::Mask,
     certain: [(L::Mask, L::Mask); 3],
     mut front: L::Mask,
@@ -414,14 +561,12 @@ fn exact_signs<L: Lane>(
         if lo.partial_cmp(&hi) != Some(core::cmp::Ordering::Less) {
             continue; // an invalid ray misses anyway
         }
-        let w = |v: V3<L>| {
-            [
-                v.x.lane(i).to_f64(),
-                v.y.lane(i).to_f64(),
-                v.z.lane(i).to_f64(),
-            ]
-        };
-        let (d, a, b, c) = (w(ray.dir), w(f.a), w(f.b), w(f.c));
+        let d = [
+            ray.dir.x.lane(i).to_f64(),
+            ray.dir.y.lane(i).to_f64(),
+            ray.dir.z.lane(i).to_f64(),
+        ];
+        let [a, b, c] = f.vertices(i);
         let mut signs = [0i32; 3];
         for (k, (p, q)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
             let (pos, neg) = certain[k];
@@ -475,9 +620,19 @@ pub fn closest_prepared<L: Lane>(
     cache: &[FocalTriangle<f32>],
     cull: Cull,
 ) -> Hit<L> {
-    let mut best = hit::closest(&rays.scaled, cache, |r, e| {
-        Some(kernel(r, &FocalTriangle::splat(e), cull))
-    });
+    // Packets: two passes, the cheap edge test over a block of triangles first. One lane: a
+    // single pass (the test stops where the first pass would; and LLVM would vectorise a
+    // scalar first pass across triangles with gathers, which ran 4× slower on x86-64).
+    let mut best = if L::LANES == 1 {
+        hit::closest(&rays.scaled, cache, |r, e| maybe_hit(r, &Splat(e), cull))
+    } else {
+        hit::closest_filtered(
+            &rays.scaled,
+            cache,
+            |r, e| candidate(r, &Splat(e), cull),
+            |r, e| maybe_hit(r, &Splat(e), cull),
+        )
+    };
     best.t = best.t * rays.scale;
     best
 }
@@ -494,9 +649,7 @@ pub fn closest<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull:
 #[must_use]
 pub fn any<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull: Cull) -> L::Mask {
     let fr = FocalRays::new(rays);
-    hit::any(&fr.scaled, cache, |r, e| {
-        Some(kernel(r, &FocalTriangle::splat(e), cull))
-    })
+    hit::any(&fr.scaled, cache, |r, e| maybe_hit(r, &Splat(e), cull))
 }
 
 /// Every hit of prepared rays: `f(index, hit)` for each cached triangle some lane hits (`t` in
@@ -509,7 +662,7 @@ pub fn all_prepared<L: Lane>(
     mut f: impl FnMut(u32, &LaneHit<L>),
 ) {
     for (i, e) in cache.iter().enumerate() {
-        let h = kernel(&rays.scaled, &FocalTriangle::splat(e), cull);
+        let h = kernel(&rays.scaled, &Splat(e), cull);
         if h.mask.any() {
             f(i as u32, &rays.unscale(h).normalized());
         }
@@ -542,8 +695,7 @@ pub fn closest_soa<L: Lane>(
     cull: Cull,
 ) -> Option<HitRecord> {
     let (r, s) = scaled_ray(ray);
-    hit::closest_soa(&r, cache, |r, e| Some(kernel(r, e, cull)))
-        .map(|h| HitRecord { t: h.t * s, ..h })
+    hit::closest_soa(&r, cache, |r, e| maybe_hit(r, e, cull)).map(|h| HitRecord { t: h.t * s, ..h })
 }
 
 /// True when one ray from the eye hits some cached triangle packed in lanes.
@@ -551,5 +703,5 @@ pub fn closest_soa<L: Lane>(
 #[must_use]
 pub fn any_soa<L: Lane>(ray: &Ray, cache: &[FocalTriangle<L>], cull: Cull) -> bool {
     let (r, _) = scaled_ray(ray);
-    hit::any_soa(&r, cache, |r, e| Some(kernel(r, e, cull)))
+    hit::any_soa(&r, cache, |r, e| maybe_hit(r, e, cull))
 }

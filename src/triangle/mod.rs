@@ -20,7 +20,7 @@
 //! that win so far: the loops relax `t_max` after each hit so that the rounded product never
 //! drops a winner, and take a candidate only when its rounded `t` is below the best, so every
 //! traversal order and both packet shapes find the same closest hit, bit for bit (see
-//! [`hit`](crate::hit)). `u`, `v` are divided once per ray, for the winner.
+//! [`crate::hit`]). `u`, `v` are divided once per ray, for the winner.
 //!
 //! **Entry points.** [`intersect`] (one ray, one triangle), [`closest`], [`any`], [`all`] (ray
 //! packets over a slice of triangles: N rays × 1 triangle) and [`closest_soa`], [`any_soa`]
@@ -264,7 +264,7 @@ pub trait TriangleKernel {
 ///    2 cmp; a triangle behind the origin costs no division.
 /// 2. The upper end before dividing: `num_t < t_max·den` — 1 mul, 1 cmp. The product rounds,
 ///    but the closest-hit loops relax `t_max` to `t + |t|·2^-21` after each hit and take a
-///    candidate only when its rounded `t` is below the best (see [`hit`](crate::hit)), so
+///    candidate only when its rounded `t` is below the best (see [`crate::hit`]), so
 ///    this never drops a hit that would win: only the hits that win so far reach step 3.
 /// 3. `t = num_t/den` (1 div), strictly inside `(t_min, t_max)` — 2 cmp. `u`, `v` stay
 ///    unscaled with `den`: the loops divide them once per ray, for the winner.
