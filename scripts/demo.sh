@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# The main job: every kernel on the test vectors (exact references), and the operation counts.
+# Every kernel on the test vectors (exact references), and the operation counts. (The main
+# job, the renderer, is `cargo run --release --example render`.)
 #
 #   ./scripts/demo.sh
 set -euo pipefail

@@ -15,6 +15,8 @@
 #    every vector through every method and width, and their digests.
 # 7. Firmware checks: the kernels link with a panic handler that does not exist (no panic
 #    path), their square roots are `vsqrt.f32`, and their flash size.
+# 8. The demo's scene 4 rendered by the firmware on both boards (scalar lane, written to the
+#    host through semihosting) equals the host's render at every packet width, byte for byte.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -41,13 +43,14 @@ rustup component add rustfmt clippy 2>&1 | grep -v "is up to date" || true
 step "format and lints"
 cargo fmt --all -- --check
 (cd targets && cargo fmt -- --check)
-cargo clippy --quiet --workspace --all-targets --features raylane/vectors -- -D warnings
+cargo clippy --quiet --workspace --all-targets --features raylane/vectors,raylane/demo -- -D warnings
+RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps --features vectors,demo
 
 step "host test suite (x86-64)"
-cargo test --quiet --features vectors
+cargo test --quiet --features vectors,demo
 
 step "checker: every method, every lane width"
-cargo build --quiet --release --features vectors --example check --example digest
+cargo build --quiet --release --features vectors,demo --example check --example digest --example render
 for method in $(./target/release/examples/check --list); do
   for lanes in 1 4 8 16; do
     printf '%-16s x%-3s' "$method" "$lanes"
@@ -70,15 +73,15 @@ same() { # same NAME FILE: FILE's digests equal the baseline's
 
 for cpu in x86-64-v3 native; do
   step "host test suite, -C target-cpu=$cpu"
-  RUSTFLAGS="-C target-cpu=$cpu" cargo test --quiet --features vectors --target-dir "target/cpu-$cpu"
-  RUSTFLAGS="-C target-cpu=$cpu" cargo run --quiet --release --features vectors --example digest \
+  RUSTFLAGS="-C target-cpu=$cpu" cargo test --quiet --features vectors,demo --target-dir "target/cpu-$cpu"
+  RUSTFLAGS="-C target-cpu=$cpu" cargo run --quiet --release --features vectors,demo --example digest \
     --target-dir "target/cpu-$cpu" | grep '^digest' > "target/digests/$cpu.txt"
   same "$cpu" "target/digests/$cpu.txt"
 done
 
 step "AArch64 (NEON) test suite under qemu-aarch64"
-cargo test --quiet --release --features vectors --target aarch64-unknown-linux-gnu
-cargo run --quiet --release --features vectors --example digest --target aarch64-unknown-linux-gnu \
+cargo test --quiet --release --features vectors,demo --target aarch64-unknown-linux-gnu
+cargo run --quiet --release --features vectors,demo --example digest --target aarch64-unknown-linux-gnu \
   | grep '^digest' > target/digests/aarch64.txt
 same aarch64 target/digests/aarch64.txt
 
@@ -117,6 +120,31 @@ empty=$(text "$m4/empty")
 echo "flash on Cortex-M4F: every kernel, scalar: $(( $(text "$m4/kernels") - empty )) B of code;" \
   "with 4-lane packets too: $(( $(text "$m4/kernels_x4") - empty )) B (empty firmware: $empty B)"
 cd "$root"
+
+step "firmware render vs host render: scene 4 at 64x48, byte for byte"
+mkdir -p target/render
+cd "$root/targets"
+for t in thumbv7em-none-eabihf:cortex-m4f thumbv8m.main-none-eabihf:cortex-m33; do
+  target=${t%%:*}; name=${t##*:}
+  log="$root/target/render/$name.log"
+  rm -f target/render.ppm "$root/target/render/$name.ppm"
+  status=0
+  cargo run --quiet --release --target "$target" --bin render > "$log" 2>&1 || status=$?
+  sed "s/^/$name: /" "$log"
+  [ "$status" -eq 0 ] || fail "$name render firmware exited with $status (see $log)"
+  [ -s target/render.ppm ] || fail "$name render firmware wrote no image (see $log)"
+  mv target/render.ppm "$root/target/render/$name.ppm"
+done
+cd "$root"
+for lanes in 1 4 8 16; do
+  ./target/release/examples/render --scene mix --size 64x48 --lanes "$lanes" \
+    --ppm "target/render/host-x$lanes.ppm" | sed 's/^/host: /'
+  for name in cortex-m4f cortex-m33; do
+    cmp "target/render/host-x$lanes.ppm" "target/render/$name.ppm" \
+      || fail "$name render differs from the host's at $lanes lanes"
+  done
+done
+echo "firmware images equal to the host's at 1, 4, 8 and 16 lanes ($(wc -c < target/render/cortex-m4f.ppm) bytes)"
 
 step "digests"
 for f in target/digests/*.txt; do printf '%-12s %s\n' "$(basename "$f" .txt)" "$(md5sum < "$f" | cut -c1-16)"; done

@@ -53,6 +53,8 @@
 
 pub mod bounds;
 pub mod camera;
+#[cfg(feature = "demo")]
+pub mod demo;
 pub mod hit;
 pub mod lane;
 pub mod mesh;

@@ -6,6 +6,8 @@ mod focal_precision;
 mod lanes;
 mod opcount;
 mod readme;
+#[cfg(feature = "demo")]
+mod render;
 mod triangles;
 #[cfg(feature = "vectors")]
 mod vectors;
