@@ -243,30 +243,51 @@ pub fn any<L: Lane, P>(
     hit & valid
 }
 
+/// Bit `j` set when some lane of `rays` may hit `block[j]` (at most 64 primitives). The
+/// primitives go in pairs with one branch per pair, not one per primitive: most pairs hold no
+/// candidate, and the branch is most of the cost of a certain miss.
+#[inline(always)]
+fn candidates<L: Lane, P>(
+    rays: &RayPacket<L>,
+    block: &[P],
+    candidate: &mut impl FnMut(&RayPacket<L>, &P) -> L::Mask,
+) -> u64 {
+    let mut bits = 0u64;
+    let mut pairs = block.chunks_exact(2);
+    let mut j = 0;
+    for pair in &mut pairs {
+        if let [p0, p1] = pair {
+            let (m0, m1) = (candidate(rays, p0), candidate(rays, p1));
+            if (m0 | m1).any() {
+                bits |= ((m0.any() as u64) << j) | ((m1.any() as u64) << (j + 1));
+            }
+        }
+        j += 2;
+    }
+    for p in pairs.remainder() {
+        if candidate(rays, p).any() {
+            bits |= 1 << j;
+        }
+    }
+    bits
+}
+
 /// [`closest`] in two passes per block of 64 primitives: `candidate` (a kernel's cheap first
-/// step, with no calls, so the rays stay in registers) marks the primitives some lane may hit,
-/// then `test` runs on those alone, in order. Same result as [`closest`] with `test`, provided
-/// `test` returns `None` wherever `candidate` is false and `candidate` does not depend on
-/// `t_max`.
+/// step, with no calls, so the rays stay in registers) gives the lanes that may hit each
+/// primitive, then `test` runs on the primitives some lane may hit, in order. Same result as
+/// [`closest`] with `test`, provided `test` returns `None` wherever `candidate` has no lane
+/// set and `candidate` does not depend on `t_max`.
 #[inline]
 pub fn closest_filtered<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: &[P],
-    mut candidate: impl FnMut(&RayPacket<L>, &P) -> bool,
+    mut candidate: impl FnMut(&RayPacket<L>, &P) -> L::Mask,
     mut test: impl FnMut(&RayPacket<L>, &P) -> Option<LaneHit<L>>,
 ) -> Hit<L> {
     let mut r = *rays;
     let mut best = Hit::none();
     for (b, block) in prims.chunks(64).enumerate() {
-        let mut bits = 0u64;
-        for (j, p) in block.iter().enumerate() {
-            // A branch, not `bits |= (c as u64) << j`: most primitives are no candidates, and
-            // the branch not taken costs two instructions where the bit arithmetic costs six
-            // (and more on 32-bit cores, where the shift is a 64-bit one).
-            if candidate(&r, p) {
-                bits |= 1 << j;
-            }
-        }
+        let mut bits = candidates(&r, block, &mut candidate);
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;
@@ -287,18 +308,13 @@ pub fn closest_filtered<L: Lane, P>(
 pub fn any_filtered<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: &[P],
-    mut candidate: impl FnMut(&RayPacket<L>, &P) -> bool,
+    mut candidate: impl FnMut(&RayPacket<L>, &P) -> L::Mask,
     mut test: impl FnMut(&RayPacket<L>, &P) -> Option<LaneHit<L>>,
 ) -> L::Mask {
     let valid = rays.valid();
     let mut hit = L::Mask::splat(false);
     for block in prims.chunks(64) {
-        let mut bits = 0u64;
-        for (j, p) in block.iter().enumerate() {
-            if candidate(rays, p) {
-                bits |= 1 << j;
-            }
-        }
+        let mut bits = candidates(rays, block, &mut candidate);
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;

@@ -358,11 +358,11 @@ pub trait FocalKernel {
     }
     /// The same, or `None` when no lane passes the cheap test (every lane misses).
     fn maybe_roots<L: Lane, S: FocalLanes<L>>(ray: &RayPacket<L>, s: &S) -> Option<Roots<L>>;
-    /// True when some lane passes the cheap test (step 1 alone): the first pass of the
-    /// closest/any loops, which then run the whole test only for these spheres.
+    /// The lanes that pass the cheap test (step 1 alone): the first pass of the closest/any
+    /// loops, which then run the whole test only for spheres where some lane passes.
     #[inline(always)]
-    fn candidate<L: Lane, S: FocalLanes<L>>(ray: &RayPacket<L>, s: &S) -> bool {
-        cheap(ray, s).2.any()
+    fn candidate<L: Lane, S: FocalLanes<L>>(ray: &RayPacket<L>, s: &S) -> L::Mask {
+        cheap(ray, s).2
     }
 }
 

@@ -474,26 +474,31 @@ impl<L: Lane> Edges<L> {
         (p0 | p1 | p2, n0 | n1 | n2)
     }
 
-    /// True when every lane certainly misses: it has a certainly positive and a certainly
-    /// negative edge (with back faces culled, a certainly positive edge suffices).
+    /// The lanes that certainly miss: a certainly positive and a certainly negative edge (with
+    /// back faces culled, a certainly positive edge suffices).
+    #[inline(always)]
+    fn out(&self, cull: Cull) -> L::Mask {
+        let (any_p, any_n) = self.any();
+        if cull.back() { any_p } else { any_p & any_n }
+    }
+
+    /// True when every lane certainly misses.
     #[inline(always)]
     fn all_out(&self, cull: Cull) -> bool {
-        let (any_p, any_n) = self.any();
-        let out = if cull.back() { any_p } else { any_p & any_n };
-        out.all()
+        self.out(cull).all()
     }
 }
 
-/// False when every lane certainly misses ([`maybe_hit`] then returns `None`): the first pass
-/// of the closest-hit loop, with no calls, so the rays stay in registers.
+/// The lanes that may hit (none when [`maybe_hit`] returns `None`): the first pass of the
+/// closest-hit loop, with no calls, so the rays stay in registers.
 #[inline(always)]
 #[must_use]
 pub(crate) fn candidate<L: Lane, F: FocalTriangleLanes<L>>(
     ray: &RayPacket<L>,
     f: &F,
     cull: Cull,
-) -> bool {
-    !Edges::new(ray, f).all_out(cull)
+) -> L::Mask {
+    !Edges::new(ray, f).out(cull)
 }
 
 /// [`kernel`], or `None` when no lane hits: the miss paths end before any record is built, and
