@@ -1,29 +1,40 @@
-//! Seeded scenes shared by the benchmarks.
+//! Benchmarks of raylane: seeded scenes shared by every contender, every kernel behind one
+//! dispatcher, and (feature `peers`) the peer libraries on the same data.
+//!
+//! * [`scene`]: the generators (no_std; the firmware's instruction counts include the file).
+//! * [`Frame`]: one scene of N primitives of each kind (spheres, triangles, planes, and their
+//!   focal caches) with one set of rays; [`Lanes`] the same data packed for one lane width.
+//! * [`Kernel`], [`Shape`] and [`run`]: every raylane kernel at every width in either packet
+//!   shape (N rays × 1 primitive: ray packets over a slice; 1 ray × N primitives: one ray over
+//!   primitives packed in lanes), each frame one out-of-line function ([`packets_frame`],
+//!   [`soa_frame`]) so that timings do not depend on how a closure happens to be inlined.
+//! * [`answers`]: the closest hit of every ray, to check contenders against each other.
+//! * `peers` (feature): parry3d, bevy, obvhs and Embree on a [`Frame`].
+
+use std::hint::black_box;
 
 use glam::Vec3;
-use raylane::Pinhole;
-use raylane::sphere::Sphere;
+use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
+use raylane::sphere::SpherePacket;
+use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
+use raylane::sphere::{self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
+use raylane::triangle::focal as tf;
+use raylane::triangle::{self, Cramer, Cull, FocalTriangle, Moller, Triangle};
+use raylane::triangle::{TrianglePacket, Watertight};
+use raylane::{Hit, HitRecord, Lane, Mask, Pinhole, Ray, RayPacket};
 
-/// A small deterministic generator (xorshift64*), so every contender sees the same scene.
-pub struct Rng(u64);
+pub mod parts;
+pub mod scene;
 
-impl Rng {
-    /// A generator from a seed.
-    pub fn new(seed: u64) -> Self {
-        Rng(seed.wrapping_mul(0x9e37_79b9_7f4a_7c15) | 1)
-    }
-    /// Uniform in [lo, hi).
-    pub fn range(&mut self, lo: f32, hi: f32) -> f32 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let x = (self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 40) as f32 / (1u64 << 24) as f32;
-        lo + (hi - lo) * x
-    }
-}
+#[cfg(feature = "peers")]
+pub mod embree;
+#[cfg(feature = "peers")]
+pub mod peers;
 
-/// A general scene: `n` spheres of radius 0.2–1.5 scattered 4–40 units in front of a camera at
-/// the origin looking down −z with a 60° field of view; `width × height` primary rays.
+pub use scene::Rng;
+
+/// The scene of the guarded-vs-unguarded focal bench (issue 2): `n` spheres, seed `seed`,
+/// a `width × height` camera (kept bit for bit as it was, so its numbers stay comparable).
 pub fn sphere_scene(n: usize, seed: u64, width: u32, height: u32) -> (Pinhole, Vec<Sphere>) {
     let mut rng = Rng::new(seed);
     let cam = Pinhole::look_at(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y, 60.0, width, height);
@@ -40,4 +51,598 @@ pub fn sphere_scene(n: usize, seed: u64, width: u32, height: u32) -> (Pinhole, V
         })
         .collect();
     (cam, spheres)
+}
+
+/// Scene sizes (primitives of each kind).
+pub const SIZES: [usize; 4] = [16, 64, 256, 1024];
+
+/// Ray–primitive tests per frame: the image shrinks as N grows so that every frame does
+/// about the same work (N = 16: 128 × 128 rays; 1024: 16 × 16).
+pub const TESTS_PER_FRAME: usize = 1 << 18;
+
+/// The side of the square image for scenes of `n` primitives (a multiple of 16).
+pub fn image_side(n: usize) -> u32 {
+    let side = ((TESTS_PER_FRAME / n.max(1)) as f64).sqrt() as u32;
+    (side / 16).max(1) * 16
+}
+
+/// Which rays a frame shoots.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Rays {
+    /// Primary rays of the pinhole camera, one per pixel, row by row (one focal point).
+    Coherent,
+    /// Random origins and directions ([`scene::random_rays`]), none starting inside a sphere.
+    Incoherent,
+    /// The coherent rays whose lines clearly miss every sphere and every triangle of the
+    /// scene: every test takes its kernel's miss path (instruction counts).
+    Miss,
+}
+
+impl Rays {
+    /// Lower-case name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Rays::Coherent => "coherent",
+            Rays::Incoherent => "incoherent",
+            Rays::Miss => "miss",
+        }
+    }
+}
+
+/// One scene: `n` primitives of each kind, their focal caches for the camera's eye, and rays.
+pub struct Frame {
+    /// Primitives of each kind.
+    pub n: usize,
+    /// Which rays.
+    pub kind: Rays,
+    /// The camera (its eye is every coherent ray's origin).
+    pub cam: Pinhole,
+    /// The rays, row by row for coherent ones.
+    pub rays: Vec<Ray>,
+    /// Spheres.
+    pub spheres: Vec<Sphere>,
+    /// Guarded focal caches of the spheres.
+    pub focal_spheres: Vec<FocalSphere<f32>>,
+    /// Unguarded focal caches of the spheres.
+    pub unguarded: Vec<FocalSphere<f32>>,
+    /// Triangles.
+    pub tris: Vec<Triangle>,
+    /// Focal caches of the triangles.
+    pub focal_tris: Vec<FocalTriangle<f32>>,
+    /// Planes.
+    pub planes: Vec<Plane>,
+    /// Focal caches of the planes.
+    pub focal_planes: Vec<FocalPlane>,
+}
+
+impl Frame {
+    /// The scene of `n` primitives of each kind seen by an `image_side(n)²` camera.
+    pub fn new(n: usize, kind: Rays) -> Self {
+        let side = image_side(n);
+        Self::with_image(n, kind, side, side)
+    }
+
+    /// The scene of `n` primitives with a `width × height` camera (and as many incoherent
+    /// rays as pixels).
+    pub fn with_image(n: usize, kind: Rays, width: u32, height: u32) -> Self {
+        let cam = scene::camera(width, height);
+        let aspect = height as f32 / width as f32;
+        let spheres: Vec<Sphere> = scene::spheres(scene::SPHERE_SEED, aspect).take(n).collect();
+        let tris: Vec<Triangle> = scene::triangles(scene::TRIANGLE_SEED, aspect)
+            .take(n)
+            .collect();
+        let planes: Vec<Plane> = scene::planes(scene::PLANE_SEED, aspect).take(n).collect();
+        let pixels =
+            || (0..height).flat_map(move |y| (0..width).map(move |x| scene::pixel_ray(&cam, x, y)));
+        let rays: Vec<Ray> = match kind {
+            Rays::Coherent => pixels().collect(),
+            Rays::Incoherent => scene::random_rays(scene::RAY_SEED, aspect)
+                .filter(|r| {
+                    spheres
+                        .iter()
+                        .all(|s| (r.origin() - s.center()).length() > s.radius() * 1.01)
+                })
+                .take((width * height) as usize)
+                .collect(),
+            Rays::Miss => {
+                let mut rays: Vec<Ray> = pixels()
+                    .filter(|r| {
+                        spheres.iter().all(|s| scene::line_misses_sphere(r, s))
+                            && tris.iter().all(|t| scene::line_misses_triangle(r, t))
+                    })
+                    .collect();
+                rays.truncate(rays.len() / 16 * 16); // whole packets at every width
+                rays
+            }
+        };
+        let eye = cam.eye;
+        Frame {
+            n,
+            kind,
+            cam,
+            rays,
+            focal_spheres: spheres.iter().map(|s| FocalSphere::new(eye, s)).collect(),
+            unguarded: spheres
+                .iter()
+                .map(|s| FocalSphere::unguarded(eye, s))
+                .collect(),
+            focal_tris: tris.iter().map(|t| FocalTriangle::new(eye, t)).collect(),
+            focal_planes: planes.iter().map(|p| FocalPlane::new(eye, p)).collect(),
+            spheres,
+            tris,
+            planes,
+        }
+    }
+
+    /// Ray–primitive tests of one frame (every ray against every primitive of one kind).
+    pub fn tests(&self) -> usize {
+        self.rays.len() * self.n
+    }
+}
+
+/// A frame's data packed for lane type `L`: ray packets (N rays × 1 primitive) and primitives
+/// in lanes (1 ray × N primitives), `used` primitives of each kind.
+pub struct Lanes<L: Lane> {
+    /// The rays, `L::LANES` to a packet.
+    pub packets: Vec<RayPacket<L>>,
+    /// Spheres in lanes.
+    pub spheres: Vec<SpherePacket<L>>,
+    /// Guarded focal caches in lanes.
+    pub focal_spheres: Vec<FocalSphere<L>>,
+    /// Unguarded focal caches in lanes.
+    pub unguarded: Vec<FocalSphere<L>>,
+    /// Triangles in lanes.
+    pub tris: Vec<TrianglePacket<L>>,
+    /// Triangle focal caches in lanes.
+    pub focal_tris: Vec<FocalTriangle<L>>,
+    /// Planes in lanes.
+    pub planes: Vec<PlanePacket<L>>,
+    /// Primitives of each kind in use (the first `used` of the frame's).
+    pub used: usize,
+}
+
+fn packed<T: Copy, P: Copy>(
+    items: &[T],
+    lanes: usize,
+    dummy: P,
+    pack: impl Fn(&[T], &mut [P]) -> usize,
+) -> Vec<P> {
+    let mut out = vec![dummy; items.len().div_ceil(lanes)];
+    let n = pack(items, &mut out);
+    out.truncate(n);
+    out
+}
+
+impl<L: Lane> Lanes<L> {
+    /// Packs `frame` using its first `used` primitives of each kind (0 for the baseline runs
+    /// of the instruction counts).
+    pub fn new(frame: &Frame, used: usize) -> Self {
+        let used = used.min(frame.n);
+        let w = L::LANES;
+        let nan = Sphere::new(Vec3::ZERO, f32::NAN);
+        let never = FocalSphere::gather(&[]);
+        Lanes {
+            packets: frame.rays.chunks(w).map(RayPacket::from_rays).collect(),
+            spheres: packed(
+                &frame.spheres[..used],
+                w,
+                SpherePacket::splat(&nan),
+                SpherePacket::pack,
+            ),
+            focal_spheres: packed(&frame.focal_spheres[..used], w, never, FocalSphere::pack),
+            unguarded: packed(&frame.unguarded[..used], w, never, FocalSphere::pack),
+            tris: packed(
+                &frame.tris[..used],
+                w,
+                TrianglePacket::splat(&Triangle::never()),
+                TrianglePacket::pack,
+            ),
+            focal_tris: packed(
+                &frame.focal_tris[..used],
+                w,
+                FocalTriangle::gather(&[]),
+                FocalTriangle::pack,
+            ),
+            planes: frame.planes[..used]
+                .chunks(w)
+                .map(PlanePacket::from_planes)
+                .collect(),
+            used,
+        }
+    }
+}
+
+/// What a kernel intersects.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Prim {
+    /// Spheres.
+    Sphere,
+    /// Triangles.
+    Triangle,
+    /// Planes.
+    Plane,
+}
+
+impl Prim {
+    /// Lower-case plural name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Prim::Sphere => "spheres",
+            Prim::Triangle => "triangles",
+            Prim::Plane => "planes",
+        }
+    }
+}
+
+/// Every raylane kernel the benchmarks run (triangles two-sided, `Cull::None`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Kernel {
+    /// `sphere::Quadratic`.
+    Quadratic,
+    /// `sphere::QuadraticUnit`.
+    QuadraticUnit,
+    /// `sphere::Geometric`.
+    Geometric,
+    /// `sphere::Robust`.
+    Robust,
+    /// `sphere::focal::Focal` over guarded caches.
+    Focal,
+    /// `sphere::focal::FocalUnguarded` over unguarded caches.
+    FocalUnguarded,
+    /// `plane::closest` / `closest_soa`.
+    Plane,
+    /// `plane::closest_focal` over `FocalPlane` caches.
+    PlaneFocal,
+    /// `triangle::Cramer`.
+    Cramer,
+    /// `triangle::Moller`.
+    Moller,
+    /// `triangle::Watertight`.
+    Watertight,
+    /// `triangle::focal` over `FocalTriangle` caches.
+    TriangleFocal,
+}
+
+impl Kernel {
+    /// Every kernel, spheres first.
+    pub const ALL: [Kernel; 12] = [
+        Kernel::Quadratic,
+        Kernel::QuadraticUnit,
+        Kernel::Geometric,
+        Kernel::Robust,
+        Kernel::Focal,
+        Kernel::FocalUnguarded,
+        Kernel::Plane,
+        Kernel::PlaneFocal,
+        Kernel::Cramer,
+        Kernel::Moller,
+        Kernel::Watertight,
+        Kernel::TriangleFocal,
+    ];
+
+    /// The name (as the op-count table spells it).
+    pub fn name(self) -> &'static str {
+        match self {
+            Kernel::Quadratic => "quadratic",
+            Kernel::QuadraticUnit => "quadratic-unit",
+            Kernel::Geometric => "geometric",
+            Kernel::Robust => "robust",
+            Kernel::Focal => "focal",
+            Kernel::FocalUnguarded => "focal-unguarded",
+            Kernel::Plane => "plane",
+            Kernel::PlaneFocal => "plane-focal",
+            Kernel::Cramer => "cramer",
+            Kernel::Moller => "moller",
+            Kernel::Watertight => "watertight",
+            Kernel::TriangleFocal => "triangle-focal",
+        }
+    }
+
+    /// The kernel called `name`.
+    pub fn from_name(name: &str) -> Option<Kernel> {
+        Kernel::ALL.into_iter().find(|k| k.name() == name)
+    }
+
+    /// What it intersects.
+    pub fn prim(self) -> Prim {
+        match self {
+            Kernel::Quadratic
+            | Kernel::QuadraticUnit
+            | Kernel::Geometric
+            | Kernel::Robust
+            | Kernel::Focal
+            | Kernel::FocalUnguarded => Prim::Sphere,
+            Kernel::Plane | Kernel::PlaneFocal => Prim::Plane,
+            _ => Prim::Triangle,
+        }
+    }
+
+    /// True for the focal caches (coherent rays from the camera's eye only).
+    pub fn focal(self) -> bool {
+        matches!(
+            self,
+            Kernel::Focal | Kernel::FocalUnguarded | Kernel::PlaneFocal | Kernel::TriangleFocal
+        )
+    }
+
+    /// True when the kernel can run on `rays` (focal kernels need rays from the eye).
+    pub fn runs_on(self, rays: Rays) -> bool {
+        !self.focal() || rays != Rays::Incoherent
+    }
+
+    /// True when the kernel has the 1 ray × N primitives shape (the focal plane has none).
+    pub fn has_soa(self) -> bool {
+        self != Kernel::PlaneFocal
+    }
+
+    /// Primitive fields the miss path must read per test (the loads of the op-count
+    /// minimum): a sphere's centre and radius (4), a focal sphere's `T` and `k_lo` (4), a
+    /// plane's point and normal (6), a focal plane's numerator and normal (4), a triangle's
+    /// vertices (9), a focal triangle's three edge normals and their three bounds (12).
+    pub fn miss_loads(self) -> u32 {
+        match self.prim() {
+            Prim::Sphere => 4,
+            Prim::Plane if self.focal() => 4,
+            Prim::Plane => 6,
+            Prim::Triangle if self.focal() => 12,
+            Prim::Triangle => 9,
+        }
+    }
+}
+
+/// The two packet shapes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// N rays × 1 primitive: packets of `L::LANES` rays, each primitive splatted.
+    Packets,
+    /// 1 ray × N primitives: one ray splatted, primitives packed `L::LANES` to a lane value.
+    Soa,
+}
+
+impl Shape {
+    /// Short name (`""` for packets, `"-soa"` for the other shape), as a suffix of `xW`.
+    pub fn suffix(self) -> &'static str {
+        match self {
+            Shape::Packets => "",
+            Shape::Soa => "-soa",
+        }
+    }
+}
+
+/// One frame of closest-hit queries of ray packets; returns the number of lanes hit. Out of
+/// line, one copy per kernel and width (the closure is inlined into it).
+#[inline(never)]
+pub fn packets_frame<L: Lane, F: Fn(&RayPacket<L>) -> Hit<L>>(
+    packets: &[RayPacket<L>],
+    f: F,
+) -> u32 {
+    let mut n = 0;
+    for p in packets {
+        let h = f(black_box(p));
+        n += h.mask.bits().count_ones();
+        black_box(&h);
+    }
+    n
+}
+
+/// One frame of closest-hit queries of single rays over primitives in lanes; returns the
+/// number of rays hit. Out of line, one copy per kernel and width.
+#[inline(never)]
+pub fn soa_frame<F: Fn(&Ray) -> Option<HitRecord>>(rays: &[Ray], f: F) -> u32 {
+    let mut n = 0;
+    for r in rays {
+        let h = f(black_box(r));
+        n += h.is_some() as u32;
+        black_box(&h);
+    }
+    n
+}
+
+/// Dispatches `$body` with `$p` bound to the closest-hit query of kernel `$k` on a ray packet
+/// over `$f`'s primitives (first `$used`), and `$s` to the 1 ray × N query over `$l`.
+macro_rules! with_kernel {
+    ($k:expr, $f:expr, $l:expr, |$p:ident, $s:ident| $body:expr) => {{
+        let (f, l) = ($f, $l);
+        let u = l.used;
+        let none = Cull::None;
+        match $k {
+            Kernel::Quadratic => {
+                let $p = |r: &RayPacket<_>| sphere::closest::<Quadratic, _>(r, &f.spheres[..u]);
+                let $s = |r: &Ray| sphere::closest_soa::<Quadratic, _>(r, &l.spheres);
+                $body
+            }
+            Kernel::QuadraticUnit => {
+                let $p = |r: &RayPacket<_>| sphere::closest::<QuadraticUnit, _>(r, &f.spheres[..u]);
+                let $s = |r: &Ray| sphere::closest_soa::<QuadraticUnit, _>(r, &l.spheres);
+                $body
+            }
+            Kernel::Geometric => {
+                let $p = |r: &RayPacket<_>| sphere::closest::<Geometric, _>(r, &f.spheres[..u]);
+                let $s = |r: &Ray| sphere::closest_soa::<Geometric, _>(r, &l.spheres);
+                $body
+            }
+            Kernel::Robust => {
+                let $p = |r: &RayPacket<_>| sphere::closest::<Robust, _>(r, &f.spheres[..u]);
+                let $s = |r: &Ray| sphere::closest_soa::<Robust, _>(r, &l.spheres);
+                $body
+            }
+            Kernel::Focal => {
+                let $p = |r: &RayPacket<_>| sf::closest::<Focal, _>(r, &f.focal_spheres[..u]);
+                let $s = |r: &Ray| sf::closest_soa::<Focal, _>(r, &l.focal_spheres);
+                $body
+            }
+            Kernel::FocalUnguarded => {
+                let $p = |r: &RayPacket<_>| sf::closest::<FocalUnguarded, _>(r, &f.unguarded[..u]);
+                let $s = |r: &Ray| sf::closest_soa::<FocalUnguarded, _>(r, &l.unguarded);
+                $body
+            }
+            Kernel::Plane => {
+                let $p = |r: &RayPacket<_>| plane::closest(r, &f.planes[..u]);
+                let $s = |r: &Ray| plane::closest_soa(r, &l.planes);
+                $body
+            }
+            Kernel::PlaneFocal => {
+                let $p = |r: &RayPacket<_>| plane::closest_focal(r, &f.focal_planes[..u]);
+                // No 1 ray × N shape: the packet query of the ray splatted (not run).
+                let $s = |r: &Ray| {
+                    plane::closest_focal(&RayPacket::<f32>::splat(r), &f.focal_planes[..u]).lane(0)
+                };
+                $body
+            }
+            Kernel::Cramer => {
+                let $p = |r: &RayPacket<_>| triangle::closest::<Cramer, _>(r, &f.tris[..u], none);
+                let $s = |r: &Ray| triangle::closest_soa::<Cramer, _>(r, &l.tris, none);
+                $body
+            }
+            Kernel::Moller => {
+                let $p = |r: &RayPacket<_>| triangle::closest::<Moller, _>(r, &f.tris[..u], none);
+                let $s = |r: &Ray| triangle::closest_soa::<Moller, _>(r, &l.tris, none);
+                $body
+            }
+            Kernel::Watertight => {
+                let $p =
+                    |r: &RayPacket<_>| triangle::closest::<Watertight, _>(r, &f.tris[..u], none);
+                let $s = |r: &Ray| triangle::closest_soa::<Watertight, _>(r, &l.tris, none);
+                $body
+            }
+            Kernel::TriangleFocal => {
+                let $p = |r: &RayPacket<_>| tf::closest(r, &f.focal_tris[..u], none);
+                let $s = |r: &Ray| tf::closest_soa(r, &l.focal_tris, none);
+                $body
+            }
+        }
+    }};
+}
+
+/// Runs one frame of kernel `k` in shape `shape` over `lanes` (built from `frame`); returns
+/// the number of rays hit.
+pub fn run<L: Lane<Scalar = f32>>(k: Kernel, shape: Shape, frame: &Frame, lanes: &Lanes<L>) -> u32 {
+    with_kernel!(k, frame, lanes, |p, s| match shape {
+        Shape::Packets => packets_frame(&lanes.packets, p),
+        Shape::Soa => soa_frame(&frame.rays, s),
+    })
+}
+
+/// The closest hit of every ray of `frame` with kernel `k` in shape `shape` (for checks).
+pub fn answers<L: Lane<Scalar = f32>>(
+    k: Kernel,
+    shape: Shape,
+    frame: &Frame,
+    lanes: &Lanes<L>,
+) -> Vec<Option<HitRecord>> {
+    with_kernel!(k, frame, lanes, |p, s| match shape {
+        Shape::Packets => lanes
+            .packets
+            .iter()
+            .flat_map(|r| {
+                let h = p(r);
+                (0..L::LANES).map(move |i| h.lane(i))
+            })
+            .take(frame.rays.len())
+            .collect(),
+        Shape::Soa => frame.rays.iter().map(s).collect(),
+    })
+}
+
+/// The floating-point operations (mul, add, div, sqrt, cmp) of one frame of kernel `k` in the
+/// packet shape over the first `used` primitives, counted with the op-counting lane
+/// `Counted<f32>`: one ray at a time, so each ray takes its own path and no lane idles in a
+/// packet. (Counts over N primitives minus counts over none, divided by the tests, are the
+/// work per test the kernel's mathematics needs.)
+pub fn frame_ops(k: Kernel, frame: &Frame, used: usize) -> raylane::opcount::OpCounts {
+    use raylane::opcount::{Counted, measure};
+    let lanes = Lanes::<Counted<f32>>::new(frame, used);
+    measure(|| {
+        with_kernel!(k, frame, &lanes, |p, _s| {
+            for r in &lanes.packets {
+                black_box(p(r));
+            }
+        })
+    })
+    .1
+}
+
+/// Runs `$body` with `$L` bound to the lane type of width `$w` (1, 4, 8 or 16).
+#[macro_export]
+macro_rules! with_width {
+    ($w:expr, $L:ident => $body:expr) => {
+        match $w {
+            1 => {
+                type $L = f32;
+                $body
+            }
+            4 => {
+                type $L = wide::f32x4;
+                $body
+            }
+            8 => {
+                type $L = wide::f32x8;
+                $body
+            }
+            16 => {
+                type $L = wide::f32x16;
+                $body
+            }
+            w => panic!("no lane width {w}"),
+        }
+    };
+}
+
+/// Lane widths.
+pub const WIDTHS: [usize; 4] = [1, 4, 8, 16];
+
+/// Compares two sets of answers: returns (hit/miss disagreements, largest relative difference
+/// of `t` where both hit).
+pub fn compare(a: &[Option<f32>], b: &[Option<f32>]) -> (usize, f64) {
+    let mut bad = 0;
+    let mut worst = 0f64;
+    for (x, y) in a.iter().zip(b) {
+        match (x, y) {
+            (Some(s), Some(t)) => {
+                let d = (*s as f64 - *t as f64).abs() / (*s as f64).abs().max(1e-30);
+                worst = worst.max(d);
+            }
+            (None, None) => {}
+            _ => bad += 1,
+        }
+    }
+    bad += a.len().abs_diff(b.len());
+    (bad, worst)
+}
+
+/// The CPU's model name and SIMD level (from /proc/cpuinfo).
+pub fn cpu() -> String {
+    let info = std::fs::read_to_string("/proc/cpuinfo").unwrap_or_default();
+    let model = info
+        .lines()
+        .find(|l| l.starts_with("model name"))
+        .and_then(|l| l.split(':').nth(1))
+        .map_or("unknown CPU".to_string(), |s| s.trim().to_string());
+    let flags = info
+        .lines()
+        .find(|l| l.starts_with("flags"))
+        .unwrap_or_default();
+    let simd = ["avx512f", "avx2", "avx", "sse4_2"]
+        .into_iter()
+        .find(|f| flags.split_whitespace().any(|x| x == *f))
+        .unwrap_or("sse2");
+    let cores = info.lines().filter(|l| l.starts_with("processor")).count();
+    let compiled = if cfg!(target_feature = "avx512f") {
+        "AVX-512"
+    } else if cfg!(target_feature = "avx2") {
+        "AVX2"
+    } else {
+        "SSE2"
+    };
+    format!("{model}, {cores} cores, up to {simd}; raylane compiled for {compiled}")
+}
+
+/// The digest of a frame's rays and primitives (the firmware computes the same).
+pub fn digest(f: &Frame) -> u64 {
+    let mut d = scene::Digest::default();
+    f.rays.iter().for_each(|r| d.ray(r));
+    f.spheres.iter().for_each(|s| d.sphere(s));
+    f.tris.iter().for_each(|t| d.triangle(t));
+    f.planes.iter().for_each(|p| d.plane(p));
+    d.0
 }

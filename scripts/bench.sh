@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# raylane's benchmarks: side by side with its peers, every kernel at every lane width, and the
+# deterministic instruction counts (x86-64-v3 under callgrind, Cortex-M4F under QEMU).
+#
+#   ./scripts/bench.sh              all of it (about 15 minutes on 2 cores, builds included)
+#   ./scripts/bench.sh compare      raylane, parry3d, bevy, obvhs and Embree on the same scenes
+#   ./scripts/bench.sh kernels      every kernel × lane width × scene
+#   ./scripts/bench.sh counts       instructions per test: x86-64-v3 and Cortex-M4F
+#
+# Installs what it needs on Debian (libembree-dev for Embree, valgrind, QEMU and the ARM
+# binutils for the counts). The timed benches are built for the machine they run on
+# (`-C target-cpu=native`, in target/bench-native, so the other builds keep their caches):
+# Embree picks its widest ISA at run time, and raylane gets the same chance. Each summary is
+# printed after criterion's report and kept in target/bench/*.md.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+root=$PWD
+out="$root/target/bench"
+mkdir -p "$out"
+what=${1:-all}
+
+need=()
+[ -e /usr/include/embree3/rtcore.h ] || need+=(libembree-dev)
+if [ ${#need[@]} -gt 0 ]; then
+  sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  echo "installing: ${need[*]}"
+  $sudo apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
+fi
+
+timed() { # timed NAME ARGS...: one criterion bench, its summary kept in target/bench/NAME.md
+  local name=$1; shift
+  RUSTFLAGS="-C target-cpu=native" cargo bench --quiet -p raylane-bench --target-dir "$root/target/bench-native" \
+    --bench "$name" "$@" | tee "$out/$name.log"
+  sed -n '/^## /,$p' "$out/$name.log" > "$out/$name.md"
+}
+
+case $what in
+  all | compare) timed compare --features peers ;;&
+  all | kernels) timed kernels ;;&
+  all | counts)
+    "$root/scripts/count-x86.sh" | tee "$out/count-x86-64-v3.md"
+    "$root/scripts/count-m4f.sh" | tee "$out/count-cortex-m4f.md"
+    ;;
+  all | compare | kernels) ;;
+  *) echo "usage: $0 [all|compare|kernels|counts]" >&2; exit 2 ;;
+esac
+echo "summaries: $out/*.md"
