@@ -9,6 +9,7 @@
 //!   primitives packed in lanes), each frame one out-of-line function ([`packets_frame`],
 //!   [`soa_frame`]) so that timings do not depend on how a closure happens to be inlined.
 //! * [`answers`]: the closest hit of every ray, to check contenders against each other.
+//! * [`parts`]: the triangles in parts of 16 with bounding spheres (raylane's answer to a BVH).
 //! * `peers` (feature): parry3d, bevy, obvhs and Embree on a [`Frame`].
 
 use std::hint::black_box;
