@@ -38,7 +38,7 @@ use criterion::{Criterion, Throughput};
 use raylane::Lane;
 use raylane_bench::embree;
 use raylane_bench::parts::{self, Parts};
-use raylane_bench::peers::{BevySpheres, ObvhsTriangles, ParryBalls, ParryTriangles};
+use raylane_bench::peers::{BevySpheres, ObvhsTriangles, ParryBalls, ParryTriangles, Peer};
 use raylane_bench::{Frame, Kernel, Lanes, Prim, Rays, SIZES, Shape, answers, cpu, run};
 
 /// Triangles per part (bounding sphere) in the culled contender.

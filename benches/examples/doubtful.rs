@@ -4,14 +4,14 @@ use raylane::opcount::{Counted, measure};
 use raylane::sphere::FocalSphere;
 use raylane::sphere::focal::{Focal, FocalKernel};
 use raylane::{Mask, RayPacket};
-use raylane_bench::sphere_scene;
+use raylane_bench::GuardScene;
 fn main() {
     for n in [16usize, 64, 256] {
-        let (cam, spheres) = sphere_scene(n, 7, 128, 96);
-        let cache: Vec<FocalSphere<f32>> = spheres
-            .iter()
-            .map(|s| FocalSphere::new(cam.eye, s))
-            .collect();
+        let GuardScene {
+            cam,
+            guarded: cache,
+            ..
+        } = GuardScene::new(n);
         let (mut tests, mut perp, mut doubtful, mut hits) = (0u64, 0u64, 0u64, 0u64);
         for y in 0..cam.height {
             for x in 0..cam.width {

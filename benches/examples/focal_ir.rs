@@ -1,4 +1,4 @@
-//! Runs the focal benchmark loop `REPS` times, guarded or unguarded, for instruction counting:
+//! Runs the guard scene's frame `REPS` times, guarded or unguarded, for instruction counting:
 //!
 //! ```text
 //! cargo build --release -p raylane-bench --example focal_ir
@@ -6,43 +6,23 @@
 //! ```
 //!
 //! Instructions per packet test = (count at REPS − count at 0) / REPS / (1536 packets · N).
-use raylane::Ray8;
-use raylane::sphere::FocalSphere;
-use raylane::sphere::focal::{self, Focal, FocalUnguarded};
-use raylane_bench::sphere_scene;
-use std::hint::black_box;
+use raylane::sphere::focal::{Focal, FocalUnguarded};
+use raylane_bench::{GuardScene, guard_frame};
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
-    let guarded = args.get(1).map(|s| s == "guarded").unwrap_or(true);
+    let guarded = args.get(1).is_none_or(|s| s == "guarded");
     let n: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(64);
     let reps: usize = args.get(3).and_then(|s| s.parse().ok()).unwrap_or(1);
-    let (cam, spheres) = sphere_scene(n, 7, 128, 96);
-    let packets: Vec<Ray8> = (0..cam.height)
-        .flat_map(|y| (0..cam.width).step_by(8).map(move |x| (x, y)))
-        .map(|(x, y)| cam.row_packet(x, y))
-        .collect();
-    let cache: Vec<FocalSphere<f32>> = spheres
-        .iter()
-        .map(|s| {
+    let s = GuardScene::new(n);
+    let hits: u32 = (0..reps)
+        .map(|_| {
             if guarded {
-                FocalSphere::new(cam.eye, s)
+                guard_frame::<Focal>(&s.packets, &s.guarded)
             } else {
-                FocalSphere::unguarded(cam.eye, s)
+                guard_frame::<FocalUnguarded>(&s.packets, &s.unguarded)
             }
         })
-        .collect();
-    let mut hits = 0u32;
-    for _ in 0..reps {
-        for p in &packets {
-            hits += if guarded {
-                focal::closest::<Focal, _>(black_box(p), &cache)
-            } else {
-                focal::closest::<FocalUnguarded, _>(black_box(p), &cache)
-            }
-            .mask
-            .to_bitmask()
-            .count_ones();
-        }
-    }
+        .sum();
     println!("{hits}");
 }

@@ -3,57 +3,31 @@
 use std::hint::black_box;
 use std::time::Instant;
 
-use raylane::Ray8;
-use raylane::sphere::FocalSphere;
-use raylane::sphere::focal::{self, Focal, FocalUnguarded};
-use raylane_bench::sphere_scene;
+use raylane::sphere::focal::{Focal, FocalUnguarded};
+use raylane_bench::{GuardScene, guard_frame};
 
 fn main() {
     for n in [16usize, 64, 256] {
-        let (cam, spheres) = sphere_scene(n, 7, 128, 96);
-        let packets: Vec<Ray8> = (0..cam.height)
-            .flat_map(|y| (0..cam.width).step_by(8).map(move |x| (x, y)))
-            .map(|(x, y)| cam.row_packet(x, y))
-            .collect();
-        let g: Vec<FocalSphere<f32>> = spheres
-            .iter()
-            .map(|s| FocalSphere::new(cam.eye, s))
-            .collect();
-        let u: Vec<FocalSphere<f32>> = spheres
-            .iter()
-            .map(|s| FocalSphere::unguarded(cam.eye, s))
-            .collect();
+        let s = GuardScene::new(n);
         let (mut best_g, mut best_u) = (f64::MAX, f64::MAX);
         // Alternate which variant runs first in a round, so order effects cancel out.
         for round in 0..80 {
-            for first in [round % 2 == 0, round % 2 == 1] {
+            for unguarded in [round % 2 == 0, round % 2 == 1] {
                 let t = Instant::now();
-                let mut h = 0u32;
-                if first {
-                    for p in &packets {
-                        h += focal::closest::<FocalUnguarded, _>(black_box(p), &u)
-                            .mask
-                            .to_bitmask()
-                            .count_ones();
-                    }
+                black_box(if unguarded {
+                    guard_frame::<FocalUnguarded>(&s.packets, &s.unguarded)
                 } else {
-                    for p in &packets {
-                        h += focal::closest::<Focal, _>(black_box(p), &g)
-                            .mask
-                            .to_bitmask()
-                            .count_ones();
-                    }
-                }
-                black_box(h);
+                    guard_frame::<Focal>(&s.packets, &s.guarded)
+                });
                 let e = t.elapsed().as_secs_f64();
-                if first {
+                if unguarded {
                     best_u = best_u.min(e)
                 } else {
                     best_g = best_g.min(e)
                 }
             }
         }
-        let tests = (packets.len() * 8 * n) as f64;
+        let tests = s.tests() as f64;
         println!(
             "n={n:3}: unguarded {:.0} Mtests/s, guarded {:.0} Mtests/s, guarded/unguarded time {:.3}",
             tests / best_u / 1e6,

@@ -34,9 +34,67 @@ pub mod peers;
 
 pub use scene::Rng;
 
-/// The scene of the guarded-vs-unguarded focal bench (issue 2): `n` spheres, seed `seed`,
-/// a `width × height` camera (kept bit for bit as it was, so its numbers stay comparable).
-pub fn sphere_scene(n: usize, seed: u64, width: u32, height: u32) -> (Pinhole, Vec<Sphere>) {
+/// The scene of the guarded-vs-unguarded focal bench (issue 2; `benches/focal.rs` and the
+/// examples `focal_time` and `doubtful`): 8-ray packets of primary rays of a 128 × 96 camera
+/// over `n` spheres (seed 7), with both focal caches.
+pub struct GuardScene {
+    /// The camera.
+    pub cam: Pinhole,
+    /// Its primary rays, 8 to a packet, row by row.
+    pub packets: Vec<raylane::Ray8>,
+    /// Guarded caches.
+    pub guarded: Vec<FocalSphere<f32>>,
+    /// Unguarded caches.
+    pub unguarded: Vec<FocalSphere<f32>>,
+}
+
+impl GuardScene {
+    /// The scene of `n` spheres.
+    pub fn new(n: usize) -> Self {
+        let (cam, spheres) = sphere_scene(n, 7, 128, 96);
+        let packets = (0..cam.height)
+            .flat_map(|y| (0..cam.width).step_by(8).map(move |x| (x, y)))
+            .map(|(x, y)| cam.row_packet(x, y))
+            .collect();
+        let cache = |f: fn(Vec3, &Sphere) -> FocalSphere<f32>| {
+            spheres.iter().map(|s| f(cam.eye, s)).collect()
+        };
+        GuardScene {
+            packets,
+            guarded: cache(FocalSphere::new),
+            unguarded: cache(FocalSphere::unguarded),
+            cam,
+        }
+    }
+
+    /// Ray–sphere tests per frame.
+    pub fn tests(&self) -> usize {
+        self.packets.len() * 8 * self.guarded.len()
+    }
+}
+
+/// One frame of the guard scene: the closest hit of every packet over `cache` with kernel `K`;
+/// returns the number of lanes hit. Out of line, so both variants are compiled once and the
+/// comparison does not depend on how a closure happens to be inlined and placed.
+#[inline(never)]
+pub fn guard_frame<K: sf::FocalKernel>(
+    packets: &[raylane::Ray8],
+    cache: &[FocalSphere<f32>],
+) -> u32 {
+    packets
+        .iter()
+        .map(|p| {
+            sf::closest::<K, _>(black_box(p), cache)
+                .mask
+                .bits()
+                .count_ones()
+        })
+        .sum()
+}
+
+/// `n` spheres, seed `seed`, a `width × height` camera (kept bit for bit as it was, so the
+/// guard bench's numbers stay comparable).
+fn sphere_scene(n: usize, seed: u64, width: u32, height: u32) -> (Pinhole, Vec<Sphere>) {
     let mut rng = Rng::new(seed);
     let cam = Pinhole::look_at(Vec3::ZERO, Vec3::NEG_Z, Vec3::Y, 60.0, width, height);
     let spheres = (0..n)

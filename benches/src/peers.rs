@@ -17,6 +17,35 @@ use std::hint::black_box;
 
 use crate::Frame;
 
+/// A peer library holding a frame's primitives and rays in its own types.
+pub trait Peer {
+    /// The peer's ray type.
+    type Ray;
+
+    /// The frame's rays, converted.
+    fn rays(&self) -> &[Self::Ray];
+
+    /// The closest hit of one ray over every primitive: `(t, index)`.
+    fn closest(&self, ray: &Self::Ray) -> Option<(f32, u32)>;
+
+    /// One frame; returns the number of rays hit. Out of line, one copy per peer.
+    #[inline(never)]
+    fn frame(&self) -> u32 {
+        let mut n = 0;
+        for r in self.rays() {
+            let h = self.closest(black_box(r));
+            n += h.is_some() as u32;
+            black_box(&h);
+        }
+        n
+    }
+
+    /// The closest hit of every ray.
+    fn answers(&self) -> Vec<Option<(f32, u32)>> {
+        self.rays().iter().map(|r| self.closest(r)).collect()
+    }
+}
+
 /// parry3d's glam (0.33) vector from ours (0.34).
 fn pv(v: glam::Vec3) -> parry3d::math::Vector {
     parry3d::math::Vector::new(v.x, v.y, v.z)
@@ -50,6 +79,14 @@ impl ParryBalls {
                 .collect(),
         }
     }
+}
+
+impl Peer for ParryBalls {
+    type Ray = parry3d::query::Ray;
+
+    fn rays(&self) -> &[parry3d::query::Ray] {
+        &self.rays
+    }
 
     #[inline(always)]
     fn closest(&self, ray: &parry3d::query::Ray) -> Option<(f32, u32)> {
@@ -66,23 +103,6 @@ impl ParryBalls {
             }
         }
         hit
-    }
-
-    /// One frame; returns the number of rays hit.
-    #[inline(never)]
-    pub fn frame(&self) -> u32 {
-        let mut n = 0;
-        for r in &self.rays {
-            let h = self.closest(black_box(r));
-            n += h.is_some() as u32;
-            black_box(&h);
-        }
-        n
-    }
-
-    /// The closest hit of every ray.
-    pub fn answers(&self) -> Vec<Option<(f32, u32)>> {
-        self.rays.iter().map(|r| self.closest(r)).collect()
     }
 }
 
@@ -108,6 +128,14 @@ impl ParryTriangles {
                 .collect(),
         }
     }
+}
+
+impl Peer for ParryTriangles {
+    type Ray = parry3d::query::Ray;
+
+    fn rays(&self) -> &[parry3d::query::Ray] {
+        &self.rays
+    }
 
     #[inline(always)]
     fn closest(&self, ray: &parry3d::query::Ray) -> Option<(f32, u32)> {
@@ -123,23 +151,6 @@ impl ParryTriangles {
             }
         }
         hit
-    }
-
-    /// One frame; returns the number of rays hit.
-    #[inline(never)]
-    pub fn frame(&self) -> u32 {
-        let mut n = 0;
-        for r in &self.rays {
-            let h = self.closest(black_box(r));
-            n += h.is_some() as u32;
-            black_box(&h);
-        }
-        n
-    }
-
-    /// The closest hit of every ray.
-    pub fn answers(&self) -> Vec<Option<(f32, u32)>> {
-        self.rays.iter().map(|r| self.closest(r)).collect()
     }
 }
 
@@ -169,6 +180,14 @@ impl BevySpheres {
                 .collect(),
         }
     }
+}
+
+impl Peer for BevySpheres {
+    type Ray = bevy_shape::RayCast3d;
+
+    fn rays(&self) -> &[bevy_shape::RayCast3d] {
+        &self.rays
+    }
 
     #[inline(always)]
     fn closest(&self, ray: &bevy_shape::RayCast3d) -> Option<(f32, u32)> {
@@ -183,23 +202,6 @@ impl BevySpheres {
             }
         }
         hit
-    }
-
-    /// One frame; returns the number of rays hit.
-    #[inline(never)]
-    pub fn frame(&self) -> u32 {
-        let mut n = 0;
-        for r in &self.rays {
-            let h = self.closest(black_box(r));
-            n += h.is_some() as u32;
-            black_box(&h);
-        }
-        n
-    }
-
-    /// The closest hit of every ray.
-    pub fn answers(&self) -> Vec<Option<(f32, u32)>> {
-        self.rays.iter().map(|r| self.closest(r)).collect()
     }
 }
 
@@ -230,6 +232,14 @@ impl ObvhsTriangles {
                 .collect(),
         }
     }
+}
+
+impl Peer for ObvhsTriangles {
+    type Ray = obvhs::ray::Ray;
+
+    fn rays(&self) -> &[obvhs::ray::Ray] {
+        &self.rays
+    }
 
     #[inline(always)]
     fn closest(&self, ray: &obvhs::ray::Ray) -> Option<(f32, u32)> {
@@ -243,22 +253,5 @@ impl ObvhsTriangles {
             }
         }
         hit
-    }
-
-    /// One frame; returns the number of rays hit.
-    #[inline(never)]
-    pub fn frame(&self) -> u32 {
-        let mut n = 0;
-        for r in &self.rays {
-            let h = self.closest(black_box(r));
-            n += h.is_some() as u32;
-            black_box(&h);
-        }
-        n
-    }
-
-    /// The closest hit of every ray.
-    pub fn answers(&self) -> Vec<Option<(f32, u32)>> {
-        self.rays.iter().map(|r| self.closest(r)).collect()
     }
 }
