@@ -91,6 +91,21 @@ impl<L: Lane> LaneHit<L> {
     }
 }
 
+impl LaneHit<f32> {
+    /// The scalar record (index 0), or `None` on a miss. `u`, `v` as stored: normalise first
+    /// where they are deferred.
+    #[inline(always)]
+    #[must_use]
+    pub fn record(self) -> Option<HitRecord> {
+        self.mask.then_some(HitRecord {
+            t: self.t,
+            u: self.u,
+            v: self.v,
+            index: 0,
+        })
+    }
+}
+
 /// The closest hit per lane over a set of primitives, with the primitive's index.
 #[derive(Clone, Copy, Debug)]
 pub struct Hit<L: Lane> {

@@ -139,13 +139,7 @@ impl FocalPlane {
 #[inline]
 #[must_use]
 pub fn intersect(ray: &Ray, plane: &Plane) -> Option<HitRecord> {
-    let h = intersect_lanes(&RayPacket::<f32>::splat(ray), &PlanePacket::splat(plane));
-    h.mask.then_some(HitRecord {
-        t: h.t,
-        u: 0.0,
-        v: 0.0,
-        index: 0,
-    })
+    intersect_lanes(&RayPacket::<f32>::splat(ray), &PlanePacket::splat(plane)).record()
 }
 
 /// Closest hit of ray lanes over a slice of planes (N rays × 1 plane).

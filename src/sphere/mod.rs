@@ -308,13 +308,9 @@ pub fn surface<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>, t: L) -> S
 #[inline]
 #[must_use]
 pub fn intersect<K: SphereKernel>(ray: &Ray, sphere: &Sphere) -> Option<HitRecord> {
-    let h = K::roots(&RayPacket::<f32>::splat(ray), &SpherePacket::splat(sphere)).first();
-    h.mask.then_some(HitRecord {
-        t: h.t,
-        u: 0.0,
-        v: 0.0,
-        index: 0,
-    })
+    K::roots(&RayPacket::<f32>::splat(ray), &SpherePacket::splat(sphere))
+        .first()
+        .record()
 }
 
 /// Closest hit of ray lanes over a slice of spheres with kernel `K` (N rays × 1 sphere).

@@ -612,13 +612,7 @@ pub fn intersect_lanes<L: Lane>(
 #[inline]
 #[must_use]
 pub fn intersect(ray: &Ray, tri: &FocalTriangle<f32>, cull: Cull) -> Option<HitRecord> {
-    let h = intersect_lanes(&FocalRays::new(&RayPacket::splat(ray)), tri, cull);
-    h.mask.then_some(HitRecord {
-        t: h.t,
-        u: h.u,
-        v: h.v,
-        index: 0,
-    })
+    intersect_lanes(&FocalRays::new(&RayPacket::splat(ray)), tri, cull).record()
 }
 
 /// Closest hit of prepared rays over cached triangles (N rays × 1 triangle).

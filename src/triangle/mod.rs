@@ -296,13 +296,9 @@ pub(crate) fn resolve<L: Lane>(
 #[must_use]
 pub fn intersect<K: TriangleKernel>(ray: &Ray, tri: &Triangle, cull: Cull) -> Option<HitRecord> {
     let r = RayPacket::<f32>::splat(ray);
-    let h = K::intersect(&r, &K::prepare(&r), &TrianglePacket::splat(tri), cull).normalized();
-    h.mask.then_some(HitRecord {
-        t: h.t,
-        u: h.u,
-        v: h.v,
-        index: 0,
-    })
+    K::intersect(&r, &K::prepare(&r), &TrianglePacket::splat(tri), cull)
+        .normalized()
+        .record()
 }
 
 /// Closest hit of ray lanes over a slice of triangles with kernel `K` (N rays × 1 triangle).
