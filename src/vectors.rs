@@ -19,6 +19,7 @@
 //! limits ([`Method::limits`]) is reported as such, not compared.
 
 use core::fmt;
+use core::hash::Hasher as _;
 
 use glam::Vec3;
 
@@ -376,6 +377,7 @@ mod limits {
     //! f64). They follow the error bounds in each kernel's documentation.
 
     use super::{Case, Kind, Limit, Method, T_TOLERANCE};
+    use crate::vec3::V3;
 
     const U: f64 = 1.0 / 16_777_216.0;
 
@@ -383,18 +385,13 @@ mod limits {
         libm::sqrt(x)
     }
 
-    fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-        [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-    }
-    fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-        a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-    }
-    fn v(c: &Case, k: usize) -> [f64; 3] {
-        [
+    /// Inputs `k..k + 3` of a case as an exact `f64` vector.
+    fn v(c: &Case, k: usize) -> V3<f64> {
+        V3::new(
             c.input[k] as f64,
             c.input[k + 1] as f64,
             c.input[k + 2] as f64,
-        ]
+        )
     }
 
     pub(super) fn check(m: Method, case: &Case) -> Limit {
@@ -412,7 +409,7 @@ mod limits {
         let d = v(case, 3);
         let ctr = v(case, 6);
         let r = case.input[9] as f64;
-        let a = dot(d, d);
+        let a = d.dot(d);
         if r.is_nan() || r <= 0.0 || a == 0.0 {
             return Limit::Inside;
         }
@@ -426,9 +423,9 @@ mod limits {
         }
         // Geometry in f64: T = C − O, μ = d·T, c² = |T|², l² = perpendicular distance², the
         // rim margin m = |r² − l²| and the roots.
-        let t = sub(ctr, o);
-        let mu = dot(d, t);
-        let c2 = dot(t, t);
+        let t = ctr - o;
+        let mu = d.dot(t);
+        let c2 = t.dot(t);
         let l2 = (c2 - mu * mu / a).max(0.0);
         let margin = (r * r - l2).abs();
         let disc_signed = mu * mu - a * (c2 - r * r);
@@ -719,7 +716,7 @@ pub struct Digest(u64);
 
 impl Default for Digest {
     fn default() -> Self {
-        Digest(0xcbf2_9ce4_8422_2325)
+        Digest(fnv::FnvHasher::default().finish())
     }
 }
 
@@ -730,19 +727,14 @@ impl Digest {
         Self::default()
     }
 
-    fn byte(&mut self, b: u8) {
-        self.0 = (self.0 ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
-    }
-
     /// Adds one outcome.
     pub fn update(&mut self, o: &Outcome) {
-        self.byte(o.applicable as u8);
-        self.byte(o.values.n);
+        let mut h = fnv::FnvHasher::with_key(self.0);
+        h.write(&[o.applicable as u8, o.values.n]);
         for x in o.values.as_slice() {
-            for b in x.to_bits().to_le_bytes() {
-                self.byte(b);
-            }
+            h.write(&x.to_bits().to_le_bytes());
         }
+        self.0 = h.finish();
     }
 
     /// The digest value.

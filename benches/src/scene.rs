@@ -16,7 +16,9 @@ use glam::Vec3;
 use raylane::plane::Plane;
 use raylane::sphere::Sphere;
 use raylane::triangle::Triangle;
-use raylane::{Pinhole, Ray, RayPacket};
+use raylane::{Pinhole, Ray, RayPacket, V3};
+
+use core::hash::Hasher as _;
 
 /// Seed of the sphere scenes.
 pub const SPHERE_SEED: u64 = 7;
@@ -133,24 +135,9 @@ pub fn random_rays(seed: u64, aspect: f32) -> impl Iterator<Item = Ray> {
     })
 }
 
-fn wide(v: Vec3) -> [f64; 3] {
-    [v.x as f64, v.y as f64, v.z as f64]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+/// `v` as an exact `f64` vector.
+fn wide(v: Vec3) -> V3<f64> {
+    V3::splat(v)
 }
 
 /// True when the whole line of `ray` passes clearly outside `s` (distance from the centre
@@ -158,26 +145,18 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 pub fn line_misses_sphere(ray: &Ray, s: &Sphere) -> bool {
     let (o, d, c) = (wide(ray.origin()), wide(ray.dir()), wide(s.center()));
     let r = s.radius() as f64;
-    let t = sub(c, o);
-    let v = dot(t, d) / dot(d, d);
-    let p = [t[0] - v * d[0], t[1] - v * d[1], t[2] - v * d[2]];
-    dot(p, p) > 1.0201 * r * r
+    let t = c - o;
+    let v = t.dot(d) / d.dot(d);
+    let p = t - d.scale(v);
+    p.dot(p) > 1.0201 * r * r
 }
 
 /// True when the line of `ray` clearly crosses the plane of `t` outside the triangle (the
 /// three edge functions of the line do not share a sign, each beyond a small margin, in f64).
 pub fn line_misses_triangle(ray: &Ray, t: &Triangle) -> bool {
     let (o, d) = (wide(ray.origin()), wide(ray.dir()));
-    let (a, b, c) = (
-        sub(wide(t.a()), o),
-        sub(wide(t.b()), o),
-        sub(wide(t.c()), o),
-    );
-    let e = [
-        dot(d, cross(a, b)),
-        dot(d, cross(b, c)),
-        dot(d, cross(c, a)),
-    ];
+    let (a, b, c) = (wide(t.a()) - o, wide(t.b()) - o, wide(t.c()) - o);
+    let e = [d.dot(a.cross(b)), d.dot(b.cross(c)), d.dot(c.cross(a))];
     let scale = e[0].abs() + e[1].abs() + e[2].abs();
     let pos = e.iter().any(|&x| x > 1e-3 * scale);
     let neg = e.iter().any(|&x| x < -1e-3 * scale);
@@ -199,16 +178,16 @@ pub struct Digest(pub u64);
 
 impl Default for Digest {
     fn default() -> Self {
-        Digest(0xcbf2_9ce4_8422_2325)
+        Digest(fnv::FnvHasher::default().finish())
     }
 }
 
 impl Digest {
-    /// Adds the bits of `x`.
+    /// Adds the bits of `x` (FNV-1a).
     pub fn f32(&mut self, x: f32) {
-        for b in x.to_bits().to_le_bytes() {
-            self.0 = (self.0 ^ b as u64).wrapping_mul(0x0000_0100_0000_01b3);
-        }
+        let mut h = fnv::FnvHasher::with_key(self.0);
+        h.write(&x.to_bits().to_le_bytes());
+        self.0 = h.finish();
     }
 
     /// Adds a vector.

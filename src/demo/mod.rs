@@ -872,9 +872,10 @@ fn to_rgb(c: [f32; 3]) -> [u8; 3] {
 /// FNV-1a (64 bits) of `bytes`: the digest the tests pin and the firmware prints.
 #[must_use]
 pub fn fnv1a(bytes: &[u8]) -> u64 {
-    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
-    })
+    use core::hash::Hasher;
+    let mut h = fnv::FnvHasher::default();
+    h.write(bytes);
+    h.finish()
 }
 
 /// Writes the header of a binary PPM (`P6`) image of `width × height` RGB8 pixels into `out`

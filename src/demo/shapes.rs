@@ -17,8 +17,13 @@
 
 use glam::Vec3;
 
+use crate::vec3::V3;
+
+/// Exact-input `f64` vectors (the crate's `V3` over the `f64` lane).
+type D3 = V3<f64>;
+
 /// The icosahedron's corners (unnormalised): `(±1, ±φ, 0)` and its cyclic permutations.
-fn corners() -> [[f64; 3]; 12] {
+fn corners() -> [D3; 12] {
     let t = (1.0 + libm::sqrt(5.0)) / 2.0;
     [
         [-1.0, t, 0.0],
@@ -34,6 +39,7 @@ fn corners() -> [[f64; 3]; 12] {
         [-t, 0.0, -1.0],
         [-t, 0.0, 1.0],
     ]
+    .map(|[x, y, z]| V3::new(x, y, z))
 }
 
 /// The icosahedron's faces, as corner indices.
@@ -60,30 +66,10 @@ const FACES: [[u8; 3]; 20] = [
     [9, 8, 1],
 ];
 
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
 /// `p/|p|` rounded to f32.
-fn unit(p: [f64; 3]) -> Vec3 {
-    let l = libm::sqrt(dot(p, p));
-    Vec3::new((p[0] / l) as f32, (p[1] / l) as f32, (p[2] / l) as f32)
-}
-
-fn wide(v: Vec3) -> [f64; 3] {
-    [v.x as f64, v.y as f64, v.z as f64]
+fn unit(p: D3) -> Vec3 {
+    let q = p.div_by(libm::sqrt(p.dot(p)));
+    Vec3::new(q.x as f32, q.y as f32, q.z as f32)
 }
 
 /// Number of vertices of the frequency-`n` icosphere: `10n² + 2`.
@@ -142,18 +128,14 @@ pub fn icosphere(
         let (a, b) = (c[p as usize], c[q as usize]);
         for k in 1..nn {
             let (wa, wb) = ((nn - k) as f64, k as f64);
-            positions[edge_base + e * m + k - 1] = unit([
-                a[0] * wa + b[0] * wb,
-                a[1] * wa + b[1] * wb,
-                a[2] * wa + b[2] * wb,
-            ]);
+            positions[edge_base + e * m + k - 1] = unit(a.scale(wa) + b.scale(wb));
         }
     }
     // 2. Per face (wound outward): interior points, then the n² triangles.
     let mut t = 0;
     for (f, face) in FACES.iter().enumerate() {
         let [ia, mut ib, mut ic] = face.map(usize::from);
-        if dot(cross(sub(c[ib], c[ia]), sub(c[ic], c[ia])), c[ia]) < 0.0 {
+        if (c[ib] - c[ia]).cross(c[ic] - c[ia]).dot(c[ia]) < 0.0 {
             core::mem::swap(&mut ib, &mut ic);
         }
         let (a, b, cc) = (c[ia], c[ib], c[ic]);
@@ -186,11 +168,7 @@ pub fn icosphere(
         for i in 1..nn {
             for j in 1..nn - i {
                 let (wa, wb, wc) = ((nn - i - j) as f64, i as f64, j as f64);
-                positions[vertex(i, j) as usize] = unit([
-                    a[0] * wa + b[0] * wb + cc[0] * wc,
-                    a[1] * wa + b[1] * wb + cc[1] * wc,
-                    a[2] * wa + b[2] * wb + cc[2] * wc,
-                ]);
+                positions[vertex(i, j) as usize] = unit(a.scale(wa) + b.scale(wb) + cc.scale(wc));
             }
         }
         for patch in 0..4 {
@@ -208,7 +186,7 @@ pub fn icosphere(
             }
         }
     }
-    orient_outward(positions, &mut indices[..t], [0.0; 3]);
+    orient_outward(positions, &mut indices[..t], D3::default());
     Some((nv, t))
 }
 
@@ -272,16 +250,20 @@ pub fn cube(positions: &mut [Vec3], indices: &mut [[u32; 3]]) -> Option<(usize, 
         indices[2 * k] = [q[0], q[1], q[2]];
         indices[2 * k + 1] = [q[0], q[2], q[3]];
     }
-    orient_outward(positions, &mut indices[..12], [0.0; 3]);
+    orient_outward(positions, &mut indices[..12], D3::default());
     Some((8, 12))
 }
 
 /// Swaps B and C of every triangle whose normal points towards `center` (convex shapes).
-fn orient_outward(positions: &[Vec3], indices: &mut [[u32; 3]], center: [f64; 3]) {
+fn orient_outward(positions: &[Vec3], indices: &mut [[u32; 3]], center: D3) {
     for t in indices {
-        let p = |i: u32| positions.get(i as usize).copied().map_or([0.0; 3], wide);
+        let p = |i: u32| {
+            positions
+                .get(i as usize)
+                .map_or(D3::default(), |v| V3::splat(*v))
+        };
         let (a, b, c) = (p(t[0]), p(t[1]), p(t[2]));
-        if dot(cross(sub(b, a), sub(c, a)), sub(a, center)) < 0.0 {
+        if (b - a).cross(c - a).dot(a - center) < 0.0 {
             t.swap(1, 2);
         }
     }
