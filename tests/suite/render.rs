@@ -21,7 +21,7 @@ use raylane::demo::{
 use raylane::plane::FocalPlane;
 use raylane::sphere::FocalSphere;
 use raylane::triangle::{Cull, FocalTriangle};
-use raylane::{Lane, RayPacket};
+use raylane::{Lane, RayPacket, V3};
 use wide::{f32x4, f32x8, f32x16};
 
 /// Caches for one frame.
@@ -84,24 +84,20 @@ fn ulp(x: f32) -> f64 {
     f64::from(a.next_up()) - f64::from(a)
 }
 
-fn w(v: Vec3) -> [f64; 3] {
-    [v.x as f64, v.y as f64, v.z as f64]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+/// `v` as an exact `f64` vector.
+fn w(v: Vec3) -> V3<f64> {
+    V3::splat(v)
 }
 
 /// Distance² from `c` to the line `o + t·d` and the position of the foot along the unit
 /// direction, in f64 from the f32 inputs (error ~2^-50·|c − o|², far below the band below).
 fn line(o: Vec3, d: Vec3, c: Vec3) -> (f64, f64) {
     let (o, d, c) = (w(o), w(d), w(c));
-    let t = [c[0] - o[0], c[1] - o[1], c[2] - o[2]];
-    let n = dot(d, d).sqrt();
-    let u = [d[0] / n, d[1] / n, d[2] / n];
-    let s = dot(t, u);
-    let p = [t[0] - s * u[0], t[1] - s * u[1], t[2] - s * u[2]];
-    (dot(p, p), s)
+    let t = c - o;
+    let u = d.div_by(d.dot(d).sqrt());
+    let s = t.dot(u);
+    let p = t - u.scale(s);
+    (p.dot(p), s)
 }
 
 /// The ray of pixel `(x, y)`: origin and direction, as the renderer's lanes compute them.
@@ -119,7 +115,7 @@ fn exact_sphere(o: Vec3, d: Vec3, c: Vec3, r: f32) -> Option<bool> {
     let mut band = 2.0 * r as f64 * 2.0 * ulp(r);
     for i in 0..3 {
         band += 2.0 * l * 2.0 * (ulp(o[i]) + ulp(c[i]));
-        band += 2.0 * l * s.abs() * 2.0 * ulp(d[i]) / dot(w(d), w(d)).sqrt();
+        band += 2.0 * l * s.abs() * 2.0 * ulp(d[i]) / w(d).dot(w(d)).sqrt();
     }
     let margin = (r as f64) * (r as f64) - l2;
     (margin.abs() > 1.5 * band).then_some(margin > 0.0)
@@ -244,16 +240,8 @@ fn icosphere_is_closed_and_wound_outward() {
                 used[i as usize] = true;
             }
             let [a, b, c] = t.map(|i| w(pos[i as usize]));
-            let (e1, e2) = (
-                [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
-                [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
-            );
-            let nrm = [
-                e1[1] * e2[2] - e1[2] * e2[1],
-                e1[2] * e2[0] - e1[0] * e2[2],
-                e1[0] * e2[1] - e1[1] * e2[0],
-            ];
-            assert!(dot(nrm, a) > 0.0, "n = {n}: a triangle faces inward");
+            let nrm = (b - a).cross(c - a);
+            assert!(nrm.dot(a) > 0.0, "n = {n}: a triangle faces inward");
         }
         assert!(used.iter().all(|&u| u), "n = {n}: unused vertex");
         for p in &pos {
@@ -281,21 +269,13 @@ fn icosphere_render_has_no_cracks() {
     let mut inradius = f64::INFINITY;
     for t in &idx {
         let [a, b, c] = t.map(|i| w(pos[i as usize]));
-        let (e1, e2) = (
-            [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
-            [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
-        );
-        let nrm = [
-            e1[1] * e2[2] - e1[2] * e2[1],
-            e1[2] * e2[0] - e1[0] * e2[2],
-            e1[0] * e2[1] - e1[1] * e2[0],
-        ];
-        inradius = inradius.min(dot(nrm, a) / dot(nrm, nrm).sqrt());
+        let nrm = (b - a).cross(c - a);
+        inradius = inradius.min(nrm.dot(a) / nrm.dot(nrm).sqrt());
     }
     let outradius = pos
         .iter()
         .map(|p| w(*p))
-        .map(|p| dot(p, p).sqrt())
+        .map(|p| p.dot(p).sqrt())
         .fold(0.0, f64::max);
     let (width, height) = (160, 120);
     let cam = scenes::icosphere_camera(width, height);

@@ -8,6 +8,7 @@ use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
+use raylane::demo::shapes;
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
 use raylane::opcount::{OpCounts, table};
@@ -726,48 +727,11 @@ struct Scene {
     idx: Vec<[u32; 3]>,
 }
 
+/// The unit icosahedron (the demo's icosphere of frequency 1): 12 vertices, 20 triangles.
 fn icosahedron() -> (Vec<Vec3>, Vec<[u32; 3]>) {
-    let t = (1.0 + 5f32.sqrt()) / 2.0;
-    let v = [
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let f = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    (
-        v.iter().map(|p| Vec3::from_array(*p).normalize()).collect(),
-        f,
-    )
+    let (mut pos, mut idx) = (vec![Vec3::ZERO; 12], vec![[0; 3]; 20]);
+    assert_eq!(shapes::icosphere(1, &mut pos, &mut idx), Some((12, 20)));
+    (pos, idx)
 }
 
 fn scene(rng: &mut SmallRng, n: usize) -> Scene {

@@ -14,6 +14,8 @@ use std::collections::HashMap;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
+use raylane::V3;
+use raylane::demo::shapes;
 use raylane::mesh::Mesh;
 use raylane::triangle::{
     Cramer, Cull, FocalRays, FocalTriangle, Moller, TriangleKernel, Watertight,
@@ -28,24 +30,9 @@ struct Shape {
     size: f32,
 }
 
-fn w(v: Vec3) -> [f64; 3] {
-    [v.x as f64, v.y as f64, v.z as f64]
-}
-
-fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+/// `v` as an exact `f64` vector.
+fn w(v: Vec3) -> V3<f64> {
+    V3::splat(v)
 }
 
 impl Shape {
@@ -59,8 +46,7 @@ impl Shape {
     ) -> Shape {
         for t in &mut idx {
             let [a, b, c] = t.map(|i| w(pos[i as usize]));
-            let n = cross(sub(b, a), sub(c, a));
-            if dot(n, sub(a, w(center))) < 0.0 {
+            if (b - a).cross(c - a).dot(a - w(center)) < 0.0 {
                 t.swap(1, 2);
             }
         }
@@ -89,82 +75,26 @@ impl Shape {
     }
 
     /// Strictly inside, by a margin relative to the size.
-    fn inside(&self, q: [f64; 3]) -> bool {
+    fn inside(&self, q: V3<f64>) -> bool {
         self.idx.iter().all(|t| {
             let [a, b, c] = t.map(|i| w(self.pos[i as usize]));
-            let n = cross(sub(b, a), sub(c, a));
-            let len = dot(n, n).sqrt();
-            dot(n, sub(q, a)) < -1e-4 * len * self.size as f64
+            let n = (b - a).cross(c - a);
+            let len = n.dot(n).sqrt();
+            n.dot(q - a) < -1e-4 * len * self.size as f64
         })
     }
 }
 
-fn icosphere(subdivisions: u32) -> Shape {
-    let t = (1.0 + 5f64.sqrt()) / 2.0;
-    let mut v: Vec<[f64; 3]> = vec![
-        [-1.0, t, 0.0],
-        [1.0, t, 0.0],
-        [-1.0, -t, 0.0],
-        [1.0, -t, 0.0],
-        [0.0, -1.0, t],
-        [0.0, 1.0, t],
-        [0.0, -1.0, -t],
-        [0.0, 1.0, -t],
-        [t, 0.0, -1.0],
-        [t, 0.0, 1.0],
-        [-t, 0.0, -1.0],
-        [-t, 0.0, 1.0],
-    ];
-    let mut f: Vec<[u32; 3]> = vec![
-        [0, 11, 5],
-        [0, 5, 1],
-        [0, 1, 7],
-        [0, 7, 10],
-        [0, 10, 11],
-        [1, 5, 9],
-        [5, 11, 4],
-        [11, 10, 2],
-        [10, 7, 6],
-        [7, 1, 8],
-        [3, 9, 4],
-        [3, 4, 2],
-        [3, 2, 6],
-        [3, 6, 8],
-        [3, 8, 9],
-        [4, 9, 5],
-        [2, 4, 11],
-        [6, 2, 10],
-        [8, 6, 7],
-        [9, 8, 1],
-    ];
-    let unit = |p: [f64; 3]| {
-        let l = dot(p, p).sqrt();
-        [p[0] / l, p[1] / l, p[2] / l]
-    };
-    v = v.into_iter().map(unit).collect();
-    for _ in 0..subdivisions {
-        let mut mid = HashMap::new();
-        let mut nf = Vec::new();
-        for [a, b, c] in f {
-            let mut m = |i: u32, j: u32| {
-                *mid.entry((i.min(j), i.max(j))).or_insert_with(|| {
-                    let (p, q) = (v[i as usize], v[j as usize]);
-                    v.push(unit([p[0] + q[0], p[1] + q[1], p[2] + q[2]]));
-                    v.len() as u32 - 1
-                })
-            };
-            let (ab, bc, ca) = (m(a, b), m(b, c), m(c, a));
-            nf.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-        }
-        f = nf;
-    }
+/// The demo's icosphere of frequency `n` (a geodesic sphere over shared vertices), radius 2
+/// about an off-axis centre.
+fn icosphere(n: u32) -> Shape {
+    let mut pos = vec![Vec3::ZERO; shapes::icosphere_vertices(n)];
+    let mut idx = vec![[0; 3]; shapes::icosphere_triangles(n)];
+    assert!(shapes::icosphere(n, &mut pos, &mut idx).is_some());
     let center = Vec3::new(0.3, -0.2, 0.1);
     let r = 2.0;
-    let pos = v
-        .iter()
-        .map(|p| center + Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32) * r)
-        .collect();
-    Shape::new("icosphere", pos, f, center, r)
+    let pos = pos.into_iter().map(|p| center + p * r).collect();
+    Shape::new("icosphere", pos, idx, center, r)
 }
 
 fn cube() -> Shape {
@@ -251,7 +181,7 @@ fn targets(s: &Shape, rng: &mut SmallRng) -> Vec<(Vec3, Target)> {
             for f in [0.25f32, 0.375, 0.75] {
                 let p = a + (b - a) * f;
                 // Exact when a + f(b − a) equals the real point (checked in f64).
-                let e = [0, 1, 2].map(|k| w(a)[k] + f as f64 * (w(b)[k] - w(a)[k]));
+                let e = w(a) + (w(b) - w(a)).scale(f as f64);
                 if w(p) == e {
                     out.push((p, Target::EdgeExact));
                 }
@@ -403,7 +333,7 @@ fn judge(h: &[(f32, u32)], crossings: usize, t: &mut Tally) {
 
 #[test]
 fn closed_meshes_leak_and_double_hit_counts() {
-    let shapes = [icosphere(2), cube(), double_cone()];
+    let shapes = [icosphere(4), cube(), double_cone()];
     let methods = [
         Method::Cramer,
         Method::Moller,
