@@ -474,13 +474,6 @@ pub fn closest<K: FocalKernel, L: Lane>(
     rays: &RayPacket<L>,
     cache: &[FocalSphere<f32>],
 ) -> hit::Hit<L> {
-    // One lane: a single pass (the test stops where the first pass would; and LLVM vectorises
-    // a scalar first pass across spheres with gathers, which ran 4× slower on x86-64).
-    if L::LANES == 1 {
-        return hit::closest(rays, cache, |r, e| {
-            K::maybe_roots(r, &Splat(e)).map(|r| r.first())
-        });
-    }
     hit::closest_filtered(
         rays,
         cache,
@@ -493,12 +486,6 @@ pub fn closest<K: FocalKernel, L: Lane>(
 #[inline]
 #[must_use]
 pub fn any<K: FocalKernel, L: Lane>(rays: &RayPacket<L>, cache: &[FocalSphere<f32>]) -> L::Mask {
-    // One lane: a single pass, as in `closest`.
-    if L::LANES == 1 {
-        return hit::any(rays, cache, |r, e| {
-            K::maybe_roots(r, &Splat(e)).map(|r| r.first())
-        });
-    }
     hit::any_filtered(
         rays,
         cache,

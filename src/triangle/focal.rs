@@ -623,19 +623,13 @@ pub fn closest_prepared<L: Lane>(
     cache: &[FocalTriangle<f32>],
     cull: Cull,
 ) -> Hit<L> {
-    // Packets: two passes, the cheap edge test over a block of triangles first. One lane: a
-    // single pass (the test stops where the first pass would; and LLVM would vectorise a
-    // scalar first pass across triangles with gathers, which ran 4× slower on x86-64).
-    let mut best = if L::LANES == 1 {
-        hit::closest(&rays.scaled, cache, |r, e| maybe_hit(r, &Splat(e), cull))
-    } else {
-        hit::closest_filtered(
-            &rays.scaled,
-            cache,
-            |r, e| candidate(r, &Splat(e), cull),
-            |r, e| maybe_hit(r, &Splat(e), cull),
-        )
-    };
+    // Two passes, the cheap edge test over a block of triangles first.
+    let mut best = hit::closest_filtered(
+        &rays.scaled,
+        cache,
+        |r, e| candidate(r, &Splat(e), cull),
+        |r, e| maybe_hit(r, &Splat(e), cull),
+    );
     best.t = best.t * rays.scale;
     best
 }
