@@ -131,13 +131,13 @@ impl<'a> Mesh<'a> {
         }
     }
 
-    /// The rays with culled lanes emptied, or `None` when no lane is left.
+    /// The rays with culled (and invalid) lanes emptied, or `None` when no lane is left.
     #[inline]
     fn culled<L: Lane>(&self, rays: &RayPacket<L>) -> Option<RayPacket<L>> {
         if self.bound.is_none() {
             return Some(*rays);
         }
-        let keep = self.may_hit(rays);
+        let keep = self.may_hit(rays) & rays.valid();
         keep.any().then(|| only(rays, keep))
     }
 
@@ -145,14 +145,25 @@ impl<'a> Mesh<'a> {
     #[inline]
     #[must_use]
     pub fn closest<K: TriangleKernel, L: Lane>(&self, rays: &RayPacket<L>, cull: Cull) -> Hit<L> {
-        let Some(r) = self.culled(rays) else {
-            return Hit::none();
-        };
+        self.try_closest::<K, L>(rays, cull)
+            .unwrap_or_else(Hit::none)
+    }
+
+    /// [`closest`](Self::closest), or `None` when the bounding sphere excludes every valid lane
+    /// (then no triangle was tested): for callers that count what culling saves.
+    #[inline]
+    #[must_use]
+    pub fn try_closest<K: TriangleKernel, L: Lane>(
+        &self,
+        rays: &RayPacket<L>,
+        cull: Cull,
+    ) -> Option<Hit<L>> {
+        let r = self.culled(rays)?;
         let pre = K::prepare(&r);
-        hit::closest(&r, 0..self.len(), |r, i| {
+        Some(hit::closest(&r, 0..self.len(), |r, i| {
             let t = self.triangle(i)?;
             Some(K::intersect(r, &pre, &TrianglePacket::splat(&t), cull))
-        })
+        }))
     }
 
     /// Lanes whose ray hits some triangle (occlusion), with kernel `K`.
@@ -278,13 +289,13 @@ impl<'c> FocalMesh<'c> {
         }
     }
 
-    /// The rays with culled lanes emptied, or `None` when no lane is left.
+    /// The rays with culled (and invalid) lanes emptied, or `None` when no lane is left.
     #[inline]
     fn culled<L: Lane>(&self, rays: &FocalRays<L>) -> Option<FocalRays<L>> {
         if self.bound.is_none() {
             return Some(*rays);
         }
-        let keep = self.may_hit(rays);
+        let keep = self.may_hit(rays) & rays.scaled.valid();
         keep.any().then(|| FocalRays {
             scaled: only(&rays.scaled, keep),
             ..*rays
@@ -295,10 +306,16 @@ impl<'c> FocalMesh<'c> {
     #[inline]
     #[must_use]
     pub fn closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Hit<L> {
-        match self.culled(rays) {
-            Some(r) => tf::closest_prepared(&r, self.cache, cull),
-            None => Hit::none(),
-        }
+        self.try_closest(rays, cull).unwrap_or_else(Hit::none)
+    }
+
+    /// [`closest`](Self::closest), or `None` when the bounding sphere excludes every valid lane
+    /// (then no triangle was tested): for callers that count what culling saves.
+    #[inline]
+    #[must_use]
+    pub fn try_closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Option<Hit<L>> {
+        self.culled(rays)
+            .map(|r| tf::closest_prepared(&r, self.cache, cull))
     }
 
     /// Lanes whose ray from the eye hits some triangle (occlusion).

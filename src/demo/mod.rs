@@ -718,27 +718,18 @@ impl<'a> Frame<'a> {
         stats: &mut Stats,
         best: &mut Best,
     ) {
-        let valid = r.valid();
         let fr = matches!(self.camera, Camera::Pinhole(_)).then(|| FocalRays::new(r));
         for (p, piece) in self.pieces.iter().enumerate() {
             let Some(piece) = piece else { break };
             let tris = k * piece.mesh.len() as u64;
             stats.bound_tests += k;
             let h = match (&fr, &piece.focal) {
-                (Some(fr), Some(fm)) => {
-                    if (fm.may_hit(fr) & valid).none() {
-                        stats.triangle_tests_saved += tris;
-                        continue;
-                    }
-                    fm.closest(fr, piece.cull)
-                }
-                _ => {
-                    if (piece.mesh.may_hit(r) & valid).none() {
-                        stats.triangle_tests_saved += tris;
-                        continue;
-                    }
-                    closest_triangles::<L>(&piece.mesh, r, piece.cull)
-                }
+                (Some(fr), Some(fm)) => fm.try_closest(fr, piece.cull),
+                _ => closest_triangles::<L>(&piece.mesh, r, piece.cull),
+            };
+            let Some(h) = h else {
+                stats.triangle_tests_saved += tris;
+                continue;
             };
             stats.triangle_tests += tris;
             best.merge(&h, ID_TRIANGLE, p as u8);
@@ -845,10 +836,10 @@ fn closest_spheres<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, s: &[Sphere]) 
     sphere::closest::<K, L>(rays, s)
 }
 
-/// [`Mesh::closest`] with [`Watertight`], out of line.
+/// [`Mesh::try_closest`] with [`Watertight`], out of line.
 #[inline(never)]
-fn closest_triangles<L: Lane>(mesh: &Mesh, rays: &RayPacket<L>, cull: Cull) -> Hit<L> {
-    mesh.closest::<Watertight, L>(rays, cull)
+fn closest_triangles<L: Lane>(mesh: &Mesh, rays: &RayPacket<L>, cull: Cull) -> Option<Hit<L>> {
+    mesh.try_closest::<Watertight, L>(rays, cull)
 }
 
 /// `⌊x⌋` by truncation (exact), saturating.
