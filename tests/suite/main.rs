@@ -1,6 +1,8 @@
 //! The host test suite, as one test binary (every kernel is monomorphised once for all tests,
 //! which keeps builds quick for each CPU configuration and for the AArch64 run).
 
+#[cfg(feature = "vectors")]
+mod accuracy;
 mod bad_input;
 mod focal_precision;
 mod lanes;

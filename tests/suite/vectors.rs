@@ -33,6 +33,38 @@ const FILES: &[(&str, &str)] = &[
         include_str!("../vectors/triangle_special.txt"),
     ),
     ("triangle_bad", include_str!("../vectors/triangle_bad.txt")),
+    ("triangle_far", include_str!("../vectors/triangle_far.txt")),
+    (
+        "triangle_needle",
+        include_str!("../vectors/triangle_needle.txt"),
+    ),
+    (
+        "triangle_grazing",
+        include_str!("../vectors/triangle_grazing.txt"),
+    ),
+    (
+        "triangle_offset",
+        include_str!("../vectors/triangle_offset.txt"),
+    ),
+    (
+        "triangle_grid",
+        include_str!("../vectors/triangle_grid.txt"),
+    ),
+    (
+        "sphere_grazing",
+        include_str!("../vectors/sphere_grazing.txt"),
+    ),
+    (
+        "sphere_offset",
+        include_str!("../vectors/sphere_offset.txt"),
+    ),
+    ("sphere_tiny", include_str!("../vectors/sphere_tiny.txt")),
+    ("sphere_huge", include_str!("../vectors/sphere_huge.txt")),
+    (
+        "plane_grazing",
+        include_str!("../vectors/plane_grazing.txt"),
+    ),
+    ("plane_offset", include_str!("../vectors/plane_offset.txt")),
 ];
 
 fn load(text: &str) -> Vec<Case> {
@@ -100,7 +132,7 @@ fn limits_leave_enough_cases() {
     };
     // Focal: every unit-direction case of every sphere file, including c/r up to 2^20 and the
     // ground sphere, inside its limits and passing.
-    assert_eq!(count("sphere_far", Method::Focal), 600);
+    assert_eq!(count("sphere_far", Method::Focal), 680);
     assert_eq!(count("sphere_ground", Method::Focal), 60);
     assert_eq!(count("sphere_bad", Method::Focal), load(FILES[5].1).len());
     // The others pass what their documented limits admit.

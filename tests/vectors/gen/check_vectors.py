@@ -10,7 +10,10 @@
 #   * re-classifies each case (hit/miss and the number of sphere roots) and
 #     re-computes t (and u, v) in double precision; the expected value must
 #     agree to within half an f32 ulp (its own rounding) + 1e-9 relative
-#     (t) / 1e-9 absolute (u, v).
+#     (t) / 1e-9 absolute (u, v);
+#   * checks the conditioning recorded after `~` (one number per expected value)
+#     against 2-ulp finite differences of the same double formulas: the sum
+#     over the inputs of |change| must agree within a factor of 2.
 # Exits non-zero on any failure.
 """Self-check for the raylane test vectors (see README.md)."""
 
@@ -162,6 +165,9 @@ def check_file(path):
         errs.append("%s: header does not name the generator / seed" % name)
     n = hits = 0
     worst = 0.0
+    cond_worst = 0.0
+    n_cond = 0
+    translated = "# conditioning: translated" in head
     for ln, line in enumerate(lines, 1):
         if not line.strip() or line.startswith("#"):
             continue
@@ -179,6 +185,7 @@ def check_file(path):
             errs.append("%s: %d inputs, expected %d" % (where, len(toks) - 1, NIN[kind]))
             continue
         xs = [parse_num(s, errs, where) for s in toks[1:]]
+        rhs, _, ktext = rhs.partition("~")
         outs = rhs.split()
         if outs == ["miss"]:
             exp = []
@@ -197,6 +204,17 @@ def check_file(path):
         if len(got) != len(exp):
             errs.append("%s: classification differs: expected %s, double reference %s" % (where, outs, got))
             continue
+        if ktext:
+            conds = [parse_num(s, errs, where) for s in ktext.split()]
+            if not exp or len(conds) != len(exp) or not all(k >= 0 for k in conds):
+                errs.append("%s: the conditioning needs one nonnegative number per expected value" % where)
+            else:
+                fd = fd_conditioning(kind, xs, got, translated)
+                for i, (k, f) in enumerate(zip(conds, fd)):
+                    if not (0.5 * f <= k <= 2 * f or (k == 0 and f == 0)):
+                        errs.append("%s: conditioning %d: recorded %g, finite differences %g" % (where, i, k, f))
+                    cond_worst = max(cond_worst, abs(math.log2(k / f)) if k and f else 0)
+                n_cond += 1
         if margin is not None and margin < 1e-9 and exp:
             errs.append("%s: double reference too close to a decision boundary (%g)" % (where, margin))
         for i, (g, e) in enumerate(zip(got, exp)):
@@ -212,14 +230,51 @@ def check_file(path):
                 errs.append("%s: t <= 0" % where)
         if kind == "sphere" and len(exp) == 2 and not exp[0] <= exp[1]:
             errs.append("%s: roots not ascending" % where)
-    return n, hits, worst, errs
+    return n, hits, worst, (n_cond, cond_worst), errs
+
+
+def step32(x, k):
+    """x moved by k f32 ulps (the f32 spacing at x; 2^-149 at 0)."""
+    return x + k * ulp32(x)
+
+
+def fd_conditioning(kind, xs, got, translated):
+    """2-ulp finite-difference conditioning of the outputs: per output, the sum over the inputs
+    of the largest |change| when that input moves by +-2 ulps (relative for t, absolute for
+    u and v).  With `translated`, the inputs are first translated so that the sphere centre,
+    the plane point or vertex a is at the origin (exact in f32 for those files)."""
+    xs = list(xs)
+    if translated:
+        shift = xs[6:9]
+        idx = [0, 1, 2, 6, 7, 8] + ([9, 10, 11, 12, 13, 14] if kind == "triangle" else [])
+        for i in idx:
+            xs[i] = xs[i] - shift[i % 3]
+            assert f32(xs[i]) == xs[i]
+    tot = [0.0] * len(got)
+    for i in range(len(xs)):
+        if translated and i in (6, 7, 8):
+            continue      # the translated origin is an exact 0, not an input
+        ch = [0.0] * len(got)
+        for k in (-2, 2):
+            ys = list(xs)
+            ys[i] = step32(xs[i], k)
+            g2, _ = REF[kind](ys)
+            if len(g2) != len(got):
+                return [float("inf")] * len(got)
+            ch = [max(c, abs(a - b)) for c, a, b in zip(ch, g2, got)]
+        tot = [t + c for t, c in zip(tot, ch)]
+    return [t / abs(g) if kind != "triangle" or j == 0 else t for j, (t, g) in enumerate(zip(tot, got))]
 
 
 def main():
     files = sorted(glob.glob(os.path.join(VEC_DIR, "*.txt")))
     expected = ["plane_bad.txt", "plane_random.txt", "sphere_bad.txt", "sphere_far.txt", "sphere_ground.txt",
                 "sphere_lecture.txt", "sphere_random.txt", "sphere_special.txt", "triangle_bad.txt",
-                "triangle_random.txt", "triangle_special.txt"]
+                "triangle_random.txt", "triangle_special.txt",
+                # accuracy classes (conditioning recorded after `~`)
+                "triangle_far.txt", "triangle_needle.txt", "triangle_grazing.txt", "triangle_offset.txt",
+                "triangle_grid.txt", "sphere_grazing.txt", "sphere_offset.txt", "sphere_tiny.txt",
+                "sphere_huge.txt", "plane_grazing.txt", "plane_offset.txt"]
     allerrs = []
     names = [os.path.basename(f) for f in files]
     for e in expected:
@@ -227,10 +282,11 @@ def main():
             allerrs.append("missing file " + e)
     total = 0
     for f in files:
-        n, h, worst, errs = check_file(f)
+        n, h, worst, (nk, kw), errs = check_file(f)
         total += n
-        print("%-22s %4d cases  %4d hits  %4d misses  max deviation beyond f32 rounding %.2g  %s" % (
-            os.path.basename(f), n, h, n - h, worst, "OK" if not errs else "%d ERRORS" % len(errs)))
+        kinfo = ("  conditioning of %d hits within 2^%.2f of finite differences" % (nk, kw)) if nk else ""
+        print("%-22s %4d cases  %4d hits  %4d misses  max deviation beyond f32 rounding %.2g%s  %s" % (
+            os.path.basename(f), n, h, n - h, worst, kinfo, "OK" if not errs else "%d ERRORS" % len(errs)))
         allerrs += errs
     for e in allerrs[:50]:
         print("ERROR", e)

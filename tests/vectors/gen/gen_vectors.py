@@ -35,6 +35,18 @@ SEEDS = {  # one independent random.Random stream per file
     "plane_random.txt": BASE_SEED + 5,
     "triangle_random.txt": BASE_SEED + 6,
     "triangle_special.txt": BASE_SEED + 7,
+    "triangle_far.txt": BASE_SEED + 11,
+    "triangle_needle.txt": BASE_SEED + 12,
+    "triangle_grazing.txt": BASE_SEED + 13,
+    "triangle_offset.txt": BASE_SEED + 14,
+    "triangle_grid.txt": BASE_SEED + 15,
+    "sphere_grazing.txt": BASE_SEED + 16,
+    "sphere_offset.txt": BASE_SEED + 17,
+    "sphere_tiny.txt": BASE_SEED + 18,
+    "sphere_huge.txt": BASE_SEED + 19,
+    "plane_grazing.txt": BASE_SEED + 20,
+    "plane_offset.txt": BASE_SEED + 21,
+    "sphere_far_low_k": BASE_SEED + 22,  # sphere_far.txt's blocks k = 4, 5 (added later)
     "robustness_check": BASE_SEED + 99,  # Monte-Carlo double check of filter (a)
 }
 
@@ -332,6 +344,7 @@ class Result:
         self.out = []         # f32 outputs (empty = miss)
         self.exact = []       # high-precision values of the outputs (mpf)
         self.dec = []         # indices of the decision quantities that matter
+        self.record = False   # write the conditioning after `~` (see cond_values)
 
     @property
     def hit(self):
@@ -641,7 +654,8 @@ class Stats:
 def accept(kind, xs, stats=None, cond="raw"):
     """Evaluate and filter one generated case.  cond: 'raw' (filter (b) on the
     inputs as given), 'translated' (filter (b) on the exactly translated inputs),
-    'report' (no filter (b); sensitivities are only recorded).
+    'report' (no filter (b); sensitivities are only recorded), 'report-translated'
+    (no filter (b); sensitivities recorded on the exactly translated inputs).
     Returns the Result (with .sens) or None."""
     if stats is not None:
         stats.tried += 1
@@ -660,7 +674,7 @@ def accept(kind, xs, stats=None, cond="raw"):
     if bad:
         return rej("(a) undecidable " + "/".join(bad))
     if res.hit:
-        xs_c = None if cond == "raw" else translated(kind, xs) if cond == "translated" else None
+        xs_c = translated(kind, xs) if cond.endswith("translated") else None
         if kind == "sphere":
             sens = sphere_sens(res, xs_c)
         elif kind == "plane":
@@ -669,7 +683,7 @@ def accept(kind, xs, stats=None, cond="raw"):
             sens = rat_sens(res, tri_quant, 0, [4, 1, 2], xs_c)
         res.sens = sens
         res.relsens = [sens[0] / abs(res.exact[0])] if kind != "sphere" else [s / abs(t) for s, t in zip(sens, res.exact)]
-        if cond != "report":
+        if not cond.startswith("report"):
             if kind == "sphere":
                 if any(s > COND_REL * abs(t) for s, t in zip(sens, res.exact)):
                     return rej("(b) ill-conditioned t")
@@ -756,7 +770,36 @@ def case_line(res):
     else:
         s = "triangle %s %s %s  %s %s %s  %s %s %s  %s %s %s  %s %s %s" % tuple(f)
     out = "miss" if not res.out else " ".join(fmt32(x) for x in res.out)
+    if res.record and res.out:
+        out += "  ~ " + " ".join(fmt32(x) for x in cond_values(res))
     return s + "  -> " + out
+
+
+def up32(x):
+    """x (a nonnegative mpf) rounded up to 3 significant decimal digits, then to f32: a
+    conditioning needs no more digits, and short numbers keep the files small."""
+    q = mp2fr(mpf(x))
+    if q == 0:
+        return 0.0
+    e = 0
+    while q >= 1000 * F(10) ** e:
+        e += 1
+    while q < 100 * F(10) ** e:
+        e -= 1
+    m = -((-q) // (F(10) ** e))          # ceil(q / 10^e), 100 <= m <= 1000
+    return dec_to_f32_exact("%de%d" % (m, e))
+
+
+def cond_values(res):
+    """The conditioning written after `~`, one number per expected value: for t, the relative
+    change a 2-ulp move of the inputs can cause (first order, sum over the inputs of
+    |dt/dx_i| 2 ulp(x_i), over |t|); for u and v the same sum, absolute.  Rounded up to 3
+    significant digits."""
+    if res.kind == "triangle":
+        vals = [res.sens[0] / abs(res.exact[0]), res.sens[1], res.sens[2]]
+    else:
+        vals = [s / abs(t) for s, t in zip(res.sens, res.exact)]
+    return [up32(v) for v in vals]
 
 
 SUMMARY = []
@@ -889,6 +932,7 @@ def gen_sphere_random():
             res = accept("sphere", list(o) + list(d) + list(c) + [r], st)
             if res is not None:
                 res.unit = unit
+                res.record = True
                 got.append(res)
         out_sections.append((cat, got))
         allcases += got
@@ -918,7 +962,17 @@ def gen_sphere_far():
     per_k = {}
     blocks = []
     allcases = []
-    for k in range(6, 21):
+    global MC_RNG
+    main_rng, main_mc = rng, MC_RNG
+    # k = 4, 5 were added later: their own streams, so that k >= 6 and every later file keep
+    # the cases they had
+    low_rng = random.Random(SEEDS["sphere_far_low_k"])
+    low_mc = random.Random(SEEDS["sphere_far_low_k"] + 1000)
+    for k in range(4, 21):
+        if k < 6:
+            rng, MC_RNG = low_rng, low_mc
+        else:
+            rng, MC_RNG = main_rng, main_mc
         kst = {"uniform": Stats(), "rim": Stats()}
         got = {"uniform": [], "rim-in": [], "rim-out": []}
         quota = {"uniform": 20, "rim-in": 10, "rim-out": 10}
@@ -947,6 +1001,7 @@ def gen_sphere_far():
                     res = accept("sphere", list(o) + list(d) + list(cc) + [r], stt)
                     if res is None:
                         continue
+                    res.record = True
                     if bucket != "uniform":
                         # classify by the actual (post-rounding) offset
                         want_hit = bucket == "rim-in"
@@ -980,7 +1035,8 @@ def gen_sphere_far():
         blk.append("")
         blocks.append(blk)
     lines = header("sphere", fname, [
-        "far small spheres, unit directions: |c - o| / r ~ 2^k for k = 6..20.",
+        "far small spheres, unit directions: |c - o| / r ~ 2^k for k = 4..20 (k = 4, 5 from their own",
+        "random streams, seeds %d and %d for the Monte-Carlo check)." % (SEEDS["sphere_far_low_k"], SEEDS["sphere_far_low_k"] + 1000),
         "THIS FILE IS WHAT THE FOCAL METHOD MUST GET RIGHT UP TO |c - o|/r = 2^20.",
         "Origin uniform in [-10,10]^3 (25% exactly at 0), direction uniform unit (f32-rounded), r",
         "log-uniform in [0.01, 10], centre at distance 2^k r * 2^U(-1/4,1/4) along the ray plus a",
@@ -1315,6 +1371,7 @@ def gen_plane_random():
                     d = tuple(-x for x in d)
             res = accept("plane", list(o) + list(d) + list(p) + list(nrm), st)
             if res is not None:
+                res.record = True
                 got.append(res)
         secs.append((cat, got))
         allcases += got
@@ -1338,6 +1395,7 @@ def gen_plane_random():
         d = v32(dv)
         res = accept("plane", list(o) + list(d) + list(p) + [float(x) for x in ax], stp)
         if res is not None:
+            res.record = True
             got.append(res)
     secs.append(("nearly parallel rays (|d.n| / (|d||n|) in [1e-4, 1e-2]), axis-aligned normals", got))
     allcases += got
@@ -1455,6 +1513,7 @@ def gen_triangle_random():
             d = dir32(rng, dv, unit)
             res = accept("triangle", list(o) + list(d) + list(a) + list(b) + list(c), st)
             if res is not None:
+                res.record = True
                 got.append(res)
         secs.append((cat, got))
         allcases += got
@@ -1649,6 +1708,432 @@ def gen_triangle_bad():
 
 
 # ---------------------------------------------------------------------------
+# accuracy classes (issue 10): hard but decidable cases with recorded conditioning
+# ---------------------------------------------------------------------------
+#
+# Each file is one class of the accuracy table (tests/suite/accuracy.rs, README).  Filter (a)
+# applies as everywhere; filter (b) does not: each hit records its conditioning after `~`
+# (see cond_values and README.md), so a checker can size a per-case tolerance and the
+# accuracy test can report errors relative to it.
+
+ACC_FILTER_TEXT = [
+    "Filters: (a) decidable at 2 ulps, as in the other files (exact gradients of every decision",
+    "  quantity; 16 random 2-ulp perturbations re-classify identically).  (b) is NOT applied: these",
+    "  cases are hard on purpose.  Instead every hit records its conditioning after `~`, one number",
+    "  per expected value: for t the relative change a 2-ulp move of the inputs can cause (first",
+    "  order: sum_i |dt/dx_i| 2 ulp_f32(x_i) / |t|), for u and v the absolute change.",
+]
+ACC_TRANSLATED_TEXT = [
+    "  Conditioning here is measured on the translated inputs (o-c, d, 0, r / o-a, d, 0, b-a, c-a /",
+    "  o-p, d, 0, n), which are exact f32 (Sterbenz): every method computes these differences",
+    "  exactly, so an absolute 2-ulp move of coordinates ~1e5 (~0.016) is not what it sees.",
+    "conditioning: translated",
+]
+
+
+def acc_file(kind, fname, title, strata, make, cond="report", per_case_note=None):
+    """Generate one accuracy class.  strata: list of (label, param, n_hit, n_miss); make(rng,
+    param, want_hit, idx) returns the raw inputs (doubles; rounded to f32 by accept) or None.
+    Cases whose exact classification differs from the wanted one are dropped (counted)."""
+    rng = random.Random(SEEDS[fname])
+    blocks = []
+    allcases = []
+    stats = []
+    idx = 0
+    for label, param, n_hit, n_miss in strata:
+        st = Stats()
+        got = {True: [], False: []}
+        quota = {True: n_hit, False: n_miss}
+        tries = 0
+        while len(got[True]) < n_hit or len(got[False]) < n_miss:
+            tries += 1
+            assert tries < 200 * (n_hit + n_miss), (fname, label, str(st))
+            # interleave hits and misses in the stratum's proportion
+            want = len(got[True]) * n_miss <= len(got[False]) * n_hit
+            if len(got[True]) >= quota[True]:
+                want = False
+            if len(got[False]) >= quota[False]:
+                want = True
+            idx += 1
+            xs = make(rng, param, want, idx)
+            if xs is None:
+                st.tried += 1
+                st.reject("construction")
+                continue
+            res = accept(kind, xs, st, cond=cond)
+            if res is None:
+                continue
+            if res.hit != want:
+                st.kept -= 1
+                st.reject("landed on the other side")
+                continue
+            res.record = True
+            got[want].append(res)
+        cases = got[True] + got[False]
+        stats.append((label, st))
+        blk = ["# --- %s: %s ---" % (label, count_note(cases)), "#   candidates: %s" % st]
+        if per_case_note:
+            blk.append("#   " + per_case_note(cases))
+        blk += [case_line(r) for r in cases]
+        blk.append("")
+        blocks.append(blk)
+        allcases += cases
+    extra = ACC_FILTER_TEXT + (ACC_TRANSLATED_TEXT if cond.endswith("translated") else [])
+    lines = header(kind, fname, title + [count_note(allcases)], filters=False, extra=extra)
+    for blk in blocks:
+        lines += blk
+    write_file(fname, lines, allcases)
+    return stats
+
+
+def cond_range(cases):
+    ts = [float(cond_values(c)[0]) for c in cases if c.hit]
+    if not ts:
+        return "no hits"
+    return "t conditioning (relative) from %.2g to %.2g" % (min(ts), max(ts))
+
+
+def uv_range(cases):
+    hs = [c for c in cases if c.hit]
+    if not hs:
+        return "no hits"
+    ts = [float(cond_values(c)[0]) for c in hs]
+    uv = [max(float(x) for x in cond_values(c)[1:]) for c in hs]
+    return "conditioning: t (relative) %.2g..%.2g, u/v (absolute) %.2g..%.2g" % (min(ts), max(ts), min(uv), max(uv))
+
+
+def mp_cos(x):
+    return float(mp.cos(x))
+
+
+def mp_sin(x):
+    return float(mp.sin(x))
+
+
+def tilted(rng, w, g):
+    """Unit vector at cos g from the unit vector w (random azimuth), random sign."""
+    e = rand_perp(rng, w)
+    s = math.sqrt(max(0.0, 1.0 - g * g))
+    n = vunit(vadd(vscale(g, w), vscale(s, e)))
+    return n if rng.random() < 0.5 else vscale(-1.0, n)
+
+
+def plane_frame(rng, n):
+    e1 = rand_perp(rng, n)
+    return e1, vunit(vcross(n, e1))
+
+
+def shaped_triangle(rng, P, n, size):
+    """A well-shaped triangle around P in the plane with normal n: vertices at angles
+    ~120 degrees apart (jitter +-0.4 rad), at 0.6..1 x size from P; f32 vertices."""
+    e1, e2 = plane_frame(rng, n)
+    phi = rng.uniform(0, 2 * math.pi)
+    vs = []
+    for k in range(3):
+        a = phi + k * 2 * math.pi / 3 + rng.uniform(-0.4, 0.4)
+        rho = size * rng.uniform(0.6, 1.0)
+        vs.append(v32(vadd(P, vadd(vscale(rho * mp_cos(a), e1), vscale(rho * mp_sin(a), e2)))))
+    if rng.random() < 0.5:
+        vs[1], vs[2] = vs[2], vs[1]
+    return vs
+
+
+def aim_uv(rng, want_hit, idx):
+    """Barycentrics (u, v) of the aim point: uniform over the triangle for a hit, or a distance
+    delta (log-uniform in [1e-3, 0.3], barycentric units) outside one of the three edges."""
+    if want_hit:
+        u, v = rng.random(), rng.random()
+        if u + v > 1:
+            u, v = 1 - u, 1 - v
+        return u, v
+    delta = loguniform(rng, 1e-3, 0.3)
+    s = rng.random()
+    edge = idx % 3
+    if edge == 0:
+        return -delta, s
+    if edge == 1:
+        return s, -delta
+    return s * (1 + delta), (1 - s) * (1 + delta)
+
+
+def tri_case(rng, o, tri, want_hit, idx):
+    u, v = aim_uv(rng, want_hit, idx)
+    Q = tri_point(*tri, u, v)
+    dv = vsub(Q, o)
+    if vnorm(dv) == 0:
+        return None
+    d = dir32(rng, dv, idx % 2 == 0)
+    return list(o) + list(d) + [x for p in tri for x in p]
+
+
+def gen_triangle_far():
+    def make(rng, k, want, idx):
+        o = (0.0, 0.0, 0.0) if rng.random() < 0.25 else v32(rand_box(rng, 1))
+        size = loguniform(rng, 0.05, 5.0)
+        c = size * float(mp.power(2, k + rng.random()))
+        w = rand_unit(rng)
+        n = tilted(rng, w, rng.uniform(0.1, 1.0))
+        tri = shaped_triangle(rng, vadd(o, vscale(c, w)), n, size)
+        return tri_case(rng, o, tri, want, idx)
+    strata = [("c/l in [2^%d, 2^%d)" % (k, k + 1), k, 18, 7) for k in range(4, 12)]
+    return acc_file("triangle", "triangle_far.txt", [
+        "accuracy class 'far': small triangles far from the ray origin, c/l from 2^4 to 2^12 (c: the",
+        "distance to the triangle's centre, l: its circumradius, log-uniform in [0.05, 5]); well-shaped",
+        "triangles, cos(angle between the view direction and the normal) uniform in [0.1, 1]; origin 0",
+        "(25%) or uniform in [-1,1]^3; directions alternate unit / non-unit.  Hits aim at a uniform",
+        "point of the triangle, misses at a point 1e-3..0.3 (barycentric) outside an edge.",
+    ], strata, make, per_case_note=uv_range)
+
+
+def gen_triangle_needle():
+    def make(rng, decade, want, idx):
+        o = (0.0, 0.0, 0.0) if rng.random() < 0.25 else v32(rand_box(rng, 1))
+        aspect = float(mp.power(10, decade + rng.random() * 0.5))
+        L = loguniform(rng, 0.5, 5.0)
+        dist = rng.uniform(1.0, 10.0)
+        w = rand_unit(rng)
+        n = tilted(rng, w, rng.uniform(0.2, 1.0))
+        P = vadd(o, vscale(dist, w))
+        e1, e2 = plane_frame(rng, n)
+        s = rng.uniform(-0.5, 0.5)
+        A = vadd(P, vscale(-L / 2, e1))
+        B = vadd(P, vscale(L / 2, e1))
+        C = vadd(P, vadd(vscale(s * L, e1), vscale(L / aspect, e2)))
+        tri = [v32(A), v32(B), v32(C)]
+        k = idx % 3
+        tri = tri[k:] + tri[:k]
+        return tri_case(rng, o, tri, want, idx)
+    strata = [("aspect ratio in [10^%.1f, 10^%.1f)" % (d, d + 0.5), d, 25, 8)
+              for d in (1.0, 1.5, 2.0, 2.5, 3.0, 3.5)]
+    return acc_file("triangle", "triangle_needle.txt", [
+        "accuracy class 'needle': needle-shaped triangles, aspect ratio (long edge / height) from 10",
+        "to 10^4; long edge log-uniform in [0.5, 5], 1..10 from the origin, cos(view, normal) in",
+        "[0.2, 1]; the apex sits anywhere along the long edge and the vertex order is rotated.",
+        "Hits aim at a uniform point, misses 1e-3..0.3 (barycentric) outside an edge.",
+    ], strata, make, per_case_note=uv_range)
+
+
+def gen_triangle_grazing():
+    def make(rng, e, want, idx):
+        o = (0.0, 0.0, 0.0) if rng.random() < 0.25 else v32(rand_box(rng, 1))
+        g = float(mp.power(2, -e - rng.random()))
+        size = loguniform(rng, 0.5, 4.0)
+        dist = size * rng.uniform(1.0, 16.0)
+        w = rand_unit(rng)
+        n = tilted(rng, w, g)
+        tri = shaped_triangle(rng, vadd(o, vscale(dist, w)), n, size)
+        args = tri_case(rng, o, tri, want, idx)
+        if args is None:
+            return None
+        # keep the stratum: the actual cos between the ray and the normal
+        d = args[3:6]
+        nn = vunit(vcross(vsub(tri[1], tri[0]), vsub(tri[2], tri[0])))
+        cg = abs(vdot(vunit(d), nn))
+        if not 2.0 ** (-e - 1) <= cg < 2.0 ** (-e + 0.25):
+            return None
+        return args
+    strata = [("cos in [2^-%d, 2^-%d)" % (e + 1, e), e, 15, 5) for e in range(0, 10)]
+    return acc_file("triangle", "triangle_grazing.txt", [
+        "accuracy class 'grazing': rays nearly parallel to the triangle, cos(ray, normal) from 1 down",
+        "to 2^-10 (the stratum is checked on the actual ray); well-shaped triangles of circumradius",
+        "0.5..4 at 1..16 x that from the origin.  Hits aim at a uniform point, misses 1e-3..0.3",
+        "(barycentric) outside an edge.",
+    ], strata, make, per_case_note=uv_range)
+
+
+def gen_triangle_offset():
+    OFF = (1e5, 1e5, 1e5)
+
+    def make(rng, _p, want, idx):
+        base = vadd(OFF, rand_box(rng, 100))
+        size = loguniform(rng, 0.5, 8.0)
+        dist = rng.uniform(1.0, 50.0)
+        w = rand_unit(rng)
+        o = v32(base)
+        n = tilted(rng, w, rng.uniform(0.2, 1.0))
+        tri = shaped_triangle(rng, vadd(o, vscale(dist, w)), n, size)
+        return tri_case(rng, o, tri, want, idx)
+    strata = [("offset 1e5", None, 150, 50)]
+    return acc_file("triangle", "triangle_offset.txt", [
+        "accuracy class 'offset': large coordinates.  Origin and triangle near (1e5, 1e5, 1e5) (within",
+        "+-150), the triangle small (circumradius 0.5..8, f32 vertices on the 2^-7 grid of 1e5) and",
+        "1..50 from the origin, cos(view, normal) in [0.2, 1].",
+    ], strata, make, cond="report-translated", per_case_note=uv_range)
+
+
+def gen_triangle_grid():
+    def grid(rng):
+        eye = v32(rand_box(rng, 1))
+        w = rand_unit(rng)
+        n = tilted(rng, w, rng.uniform(0.62, 1.0))
+        D = rng.uniform(3.0, 5.0)
+        s = rng.uniform(0.06, 0.085)
+        e1, e2 = plane_frame(rng, n)
+        return eye, vadd(eye, vscale(D, w)), s, e1, e2
+
+    state = {}
+
+    def make(rng, g, want, idx):
+        if state.get("g") != g:
+            state["g"] = g
+            state["grid"] = grid(rng)
+        eye, G, s, e1, e2 = state["grid"]
+        i, j = rng.randint(-12, 11), rng.randint(-12, 11)
+
+        def V(a, b):
+            return v32(vadd(G, vadd(vscale(a * s, e1), vscale(b * s, e2))))
+        tris = [[V(i, j), V(i + 1, j), V(i + 1, j + 1)], [V(i, j), V(i + 1, j + 1), V(i, j + 1)]]
+        k = rng.randint(0, 1)
+        u, v = rng.random(), rng.random()
+        if u + v > 1:
+            u, v = 1 - u, 1 - v
+        Q = tri_point(*tris[k], u, v)
+        tri = tris[k] if want else tris[1 - k]
+        d = dir32(rng, vsub(Q, eye), idx % 2 == 0)
+        nn = vunit(vcross(vsub(tri[1], tri[0]), vsub(tri[2], tri[0])))
+        if not abs(vdot(vunit(d), nn)) >= 0.59:
+            return None
+        return list(eye) + list(d) + [x for p in tri for x in p]
+    strata = [("grid %d" % g, g, 15, 5) for g in range(10)]
+    return acc_file("triangle", "triangle_grid.txt", [
+        "accuracy class 'grid': planar grids seen at an angle, as in Embree's watertightness test plane.",
+        "Per block one grid: square cells 0.06..0.085 wide (two triangles each, f32 grid points), its",
+        "centre 3..5 from an eye in [-1,1]^3, cos(ray, normal) from 0.59 to 1 (checked per ray); cells",
+        "within 12 of the centre.  A hit aims at a uniform point of one triangle of a cell; a miss is",
+        "the same ray against the cell's other triangle (so its nearest edge is the shared diagonal).",
+    ], strata, make, per_case_note=uv_range)
+
+
+def sphere_aim(rng, o, C, r, lr, unit):
+    """Unit/non-unit f32 direction from o whose line passes at distance lr * r from C."""
+    w = vsub(C, o)
+    c = vnorm(w)
+    w = vunit(w)
+    sa = lr * r / c
+    if sa >= 1:
+        return None
+    e = rand_perp(rng, w)
+    dv = vadd(vscale(math.sqrt(1 - sa * sa), w), vscale(sa, e))
+    return list(dir32(rng, dv, unit))
+
+
+def gen_sphere_grazing():
+    def make(rng, e, want, idx):
+        r = loguniform(rng, 0.1, 10.0)
+        k = rng.uniform(1, 8)
+        o = v32(rand_box(rng, 10))
+        C = v32(vadd(o, vscale(r * float(mp.power(2, k)), rand_unit(rng))))
+        delta = float(mp.power(2, -e - 2 * rng.random()))
+        lr = 1 - delta if want else 1 + delta
+        d = sphere_aim(rng, o, C, r, lr, idx % 2 == 0)
+        return None if d is None else list(o) + d + list(C) + [r]
+    strata = [("|1 - l/r| in [2^-%d, 2^-%d)" % (e + 2, e), e, 15, 5) for e in range(2, 20, 2)]
+    return acc_file("sphere", "sphere_grazing.txt", [
+        "accuracy class 'grazing': near-tangent rays.  The ray passes at l = (1 -+ delta) r from the",
+        "centre, delta from 2^-2 down to 2^-20 (cos of the incidence angle down to ~2^-10); r",
+        "log-uniform in [0.1, 10], c/r = 2^U(1,8), origin in [-10,10]^3; directions alternate unit /",
+        "non-unit.  Hits (l < r) and misses (l > r) per stratum; filter (a) drops the undecidable.",
+    ], strata, make, per_case_note=cond_range)
+
+
+def gen_sphere_offset():
+    OFF = (1e5, 1e5, 1e5)
+
+    def make(rng, _p, want, idx):
+        C = v32(vadd(OFF, rand_box(rng, 100)))
+        r = loguniform(rng, 0.5, 8.0)
+        if want and rng.random() < 0.15:       # origin inside
+            o = v32(vadd(C, vscale(r * rng.uniform(0, 0.9), rand_unit(rng))))
+            return list(o) + list(dir32(rng, rand_unit(rng), idx % 2 == 0)) + list(C) + [r]
+        o = v32(vadd(C, vscale(r * float(mp.power(2, rng.uniform(1, 6))), rand_unit(rng))))
+        lr = rng.uniform(0, 0.98) if want else rng.uniform(1.02, 1.5)
+        d = sphere_aim(rng, o, C, r, lr, idx % 2 == 0)
+        return None if d is None else list(o) + d + list(C) + [r]
+    strata = [("offset 1e5", None, 120, 40)]
+    return acc_file("sphere", "sphere_offset.txt", [
+        "accuracy class 'offset': large coordinates.  Centre near (1e5, 1e5, 1e5) (within +-100), r",
+        "log-uniform in [0.5, 8], origin at 2^U(1,6) r from the centre (15% of the hits from inside);",
+        "the line passes at l/r uniform in [0, 0.98] (hit) or [1.02, 1.5] (miss).",
+    ], strata, make, cond="report-translated", per_case_note=cond_range)
+
+
+def sphere_scaled(lo, hi):
+    def make(rng, _p, want, idx):
+        r = float(mp.power(2, rng.uniform(lo, hi)))
+        o = v32(rand_box(rng, 64 * r))
+        C = v32(vadd(o, vscale(r * float(mp.power(2, rng.uniform(1, 6))), rand_unit(rng))))
+        lr = rng.uniform(0, 0.98) if want else rng.uniform(1.02, 1.5)
+        d = sphere_aim(rng, o, C, r, lr, idx % 2 == 0)
+        return None if d is None else list(o) + d + list(C) + [r]
+    return make
+
+
+def gen_sphere_tiny():
+    out = [("r in [2^%d, 2^%d)" % (e, e + 4), e, 15, 5) for e in range(-24, -8, 4)]
+
+    def mk(rng, lo, want, idx):
+        return sphere_scaled(lo, lo + 4)(rng, None, want, idx)
+    return acc_file("sphere", "sphere_tiny.txt", [
+        "accuracy class 'tiny r': small spheres, r = 2^U(-24,-8), scenes scaled with r: origin in",
+        "[-64 r, 64 r]^3, centre at 2^U(1,6) r from it, l/r uniform in [0, 0.98] (hit) or",
+        "[1.02, 1.5] (miss); directions alternate unit / non-unit.",
+    ], out, mk, per_case_note=cond_range)
+
+
+def gen_sphere_huge():
+    out = [("r in [2^%d, 2^%d)" % (e, e + 4), e, 15, 5) for e in range(8, 24, 4)]
+
+    def mk(rng, lo, want, idx):
+        return sphere_scaled(lo, lo + 4)(rng, None, want, idx)
+    return acc_file("sphere", "sphere_huge.txt", [
+        "accuracy class 'huge r': large spheres, r = 2^U(8,24), scenes scaled with r: origin in",
+        "[-64 r, 64 r]^3, centre at 2^U(1,6) r from it, l/r uniform in [0, 0.98] (hit) or",
+        "[1.02, 1.5] (miss); directions alternate unit / non-unit.",
+    ], out, mk, per_case_note=cond_range)
+
+
+def gen_plane_grazing():
+    def make(rng, e, want, idx):
+        o = v32(rand_box(rng, 10))
+        w = rand_unit(rng)
+        g = float(mp.power(2, -e - rng.random()))
+        n = tilted(rng, w, g)
+        T = rng.uniform(1.0, 20.0)
+        e1, e2 = plane_frame(rng, n)
+        p = vadd(vadd(o, vscale(T if want else -T, w)), vadd(vscale(rng.uniform(-5, 5), e1), vscale(rng.uniform(-5, 5), e2)))
+        d = dir32(rng, w, idx % 2 == 0)
+        nn = dir32(rng, n, (idx // 2) % 2 == 0)
+        return list(o) + list(d) + list(v32(p)) + list(nn)
+    strata = [("cos in [2^-%d, 2^-%d)" % (e + 1, e), e, 8, 2) for e in range(0, 10)]
+    return acc_file("plane", "plane_grazing.txt", [
+        "accuracy class 'grazing': rays nearly parallel to the plane, cos(ray, normal) from 1 down to",
+        "2^-10; origin in [-10,10]^3, the plane 1..20 along the ray (behind it for the misses), its",
+        "point offset by up to 5 in the plane; normals and directions alternate unit / non-unit.",
+    ], strata, make, per_case_note=cond_range)
+
+
+def gen_plane_offset():
+    OFF = (1e5, 1e5, 1e5)
+
+    def make(rng, _p, want, idx):
+        o = v32(vadd(OFF, rand_box(rng, 100)))
+        w = rand_unit(rng)
+        n = tilted(rng, w, rng.uniform(0.1, 1.0))
+        T = rng.uniform(1.0, 50.0)
+        e1, e2 = plane_frame(rng, n)
+        p = vadd(vadd(o, vscale(T if want else -T, w)), vadd(vscale(rng.uniform(-5, 5), e1), vscale(rng.uniform(-5, 5), e2)))
+        d = dir32(rng, w, idx % 2 == 0)
+        nn = dir32(rng, n, (idx // 2) % 2 == 0)
+        return list(o) + list(d) + list(v32(p)) + list(nn)
+    strata = [("offset 1e5", None, 60, 20)]
+    return acc_file("plane", "plane_offset.txt", [
+        "accuracy class 'offset': large coordinates.  Origin and plane point near (1e5, 1e5, 1e5)",
+        "(within +-150), the plane 1..50 along the ray (behind it for the misses), cos(ray, normal)",
+        "uniform in [0.1, 1]; normals and directions alternate unit / non-unit.",
+    ], strata, make, cond="report-translated", per_case_note=cond_range)
+
+
+# ---------------------------------------------------------------------------
 
 def main():
     t0 = time.time()
@@ -1678,6 +2163,11 @@ def main():
     dropped = gen_triangle_special()
     report.append("triangle_special dropped: %s" % (dropped or "none"))
     gen_triangle_bad()
+    for gen in (gen_triangle_far, gen_triangle_needle, gen_triangle_grazing, gen_triangle_offset,
+                gen_triangle_grid, gen_sphere_grazing, gen_sphere_offset, gen_sphere_tiny,
+                gen_sphere_huge, gen_plane_grazing, gen_plane_offset):
+        for label, st in gen():
+            report.append("%s %s: %s" % (gen.__name__[4:], label, st))
     for line in report:
         print(line)
     print()
