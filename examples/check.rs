@@ -6,7 +6,9 @@
 //!
 //! Evaluates every case of the files with one method (default: the recommended general
 //! method of each kind) at one lane width, cases batched into the lanes. Prints each failing
-//! case, the number of cases outside the method's documented limits, and a closing line
+//! case (with its tolerance per value: relative for `t`, absolute for `u`, `v`, widened by the
+//! line's recorded conditioning, see `raylane::vectors::tolerance`), the number of cases
+//! outside the method's documented limits, and a closing line
 //! `N passed, M failed`; exits non-zero on any failure. With `--emit` it compares nothing and
 //! prints one line per case, in file order: `miss` or the computed values (shortest round-trip
 //! decimals), or `n/a` where the method does not apply to the line's kind. With
@@ -123,13 +125,21 @@ fn main() -> ExitCode {
                 Verdict::Pass => passed += 1,
                 Verdict::Fail => {
                     failed += 1;
+                    let tol: Vec<String> = (0..c.expect.n as usize)
+                        .map(|k| format!("{:.1e}", vectors::tolerance(c, k)))
+                        .collect();
                     println!(
-                        "FAIL {file}:{} [{}]: {}\n     expected {}, got {}",
+                        "FAIL {file}:{} [{}]: {}\n     expected {}, got {} (tolerance {})",
                         c.line,
                         m.name(),
                         lines[c.line as usize - 1].trim(),
                         c.expect,
-                        o.values
+                        o.values,
+                        if tol.is_empty() {
+                            "-".to_string()
+                        } else {
+                            tol.join(" ")
+                        }
                     );
                 }
                 Verdict::Skip(why) => bump(&mut skipped, why),

@@ -914,6 +914,32 @@ mod tests {
             parse_line("plane 0 0 0 1 0 0 2 0 0 1 0 0 -> 1 2", 1),
             Some(Err(ParseError::Expectation))
         );
+        // The conditioning after `~`: one number per expected value, on hits only.
+        let k = parse_line(
+            "triangle 0 0 0 0 0 1 0 0 1 1 0 1 0 1 1 -> 1 0 0.5 ~ 1e-7 0 3e-6",
+            1,
+        )
+        .unwrap()
+        .unwrap();
+        assert_eq!((k.cond.n, k.cond.v), (3, [1e-7, 0.0, 3e-6]));
+        assert_eq!(tolerance(&k, 0), T_TOLERANCE);
+        let k = parse_line("sphere 0 0 0 1 0 0 5 0 0 1 -> 4 6 ~ 1e-3 1e-6 # note", 1)
+            .unwrap()
+            .unwrap();
+        assert_eq!(tolerance(&k, 0), COND_FACTOR * 1e-3f32 as f64);
+        assert_eq!(tolerance(&k, 1), T_TOLERANCE);
+        for bad in [
+            "plane 0 0 0 1 0 0 2 0 0 1 0 0 -> 2 ~ 1e-7 1e-7",
+            "plane 0 0 0 1 0 0 2 0 0 1 0 0 -> miss ~ 1e-7",
+            "plane 0 0 0 1 0 0 2 0 0 1 0 0 -> 2 ~ -1",
+            "plane 0 0 0 1 0 0 2 0 0 1 0 0 -> 2 ~",
+        ] {
+            assert_eq!(
+                parse_line(bad, 1),
+                Some(Err(ParseError::Conditioning)),
+                "{bad}"
+            );
+        }
         let nan = parse_line("sphere NaN 0 0 1 0 0 inf 0 0 -1 -> miss", 1)
             .unwrap()
             .unwrap();
