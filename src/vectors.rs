@@ -1052,26 +1052,9 @@ pub mod accuracy {
         class(Kind::Plane, "offset", "plane_offset"),
     ];
 
-    /// The methods of a kind, in table order.
-    #[must_use]
-    pub fn methods(kind: Kind) -> &'static [Method] {
-        match kind {
-            Kind::Triangle => &[
-                Method::Cramer,
-                Method::Moller,
-                Method::Watertight,
-                Method::Focal,
-            ],
-            Kind::Sphere => &[
-                Method::Quadratic,
-                Method::QuadraticUnit,
-                Method::Geometric,
-                Method::Robust,
-                Method::Focal,
-                Method::FocalUnguarded,
-            ],
-            Kind::Plane => &[Method::Plane, Method::Focal],
-        }
+    /// The methods of a kind, in table order ([`Method::ALL`]'s).
+    pub fn methods(kind: Kind) -> impl Iterator<Item = Method> {
+        Method::ALL.into_iter().filter(move |m| m.applies(kind))
     }
 
     /// One method's errors over some cases.
@@ -1189,6 +1172,18 @@ pub mod accuracy {
         }
     }
 
+    /// Writes one figure of a cell (after a space): `–` when nothing was measured.
+    fn write_cell(f: &mut impl fmt::Write, e: &Errors, x: f64, ratio: bool) -> fmt::Result {
+        f.write_str(" ")?;
+        if e.hits == 0 {
+            f.write_str("–")
+        } else if ratio {
+            write_ratio(f, x)
+        } else {
+            write_error(f, x)
+        }
+    }
+
     /// Writes the report: for each kind, a table of the largest errors (rows: classes;
     /// columns: methods, `t` and for triangles `u,v`) and one of the errors over conditioning.
     /// `errors(method, class)` gives the measured figures.
@@ -1197,14 +1192,14 @@ pub mod accuracy {
         mut errors: impl FnMut(Method, &Class) -> Errors,
     ) -> fmt::Result {
         for kind in [Kind::Triangle, Kind::Sphere, Kind::Plane] {
-            let ms = methods(kind);
             let classes = || CLASSES.iter().filter(move |c| c.kind == kind);
             let mut table = [[Errors::default(); 6]; 6];
             for (i, c) in classes().enumerate() {
-                for (j, m) in ms.iter().enumerate() {
-                    table[i][j] = errors(*m, c);
+                for (j, m) in methods(kind).enumerate() {
+                    table[i][j] = errors(m, c);
                 }
             }
+            let n_methods = methods(kind).count();
             let uv = kind == Kind::Triangle;
             for ratio in [false, true] {
                 let what = if ratio {
@@ -1212,13 +1207,8 @@ pub mod accuracy {
                 } else {
                     "largest error"
                 };
-                let name = match kind {
-                    Kind::Triangle => "triangle",
-                    Kind::Sphere => "sphere",
-                    Kind::Plane => "plane",
-                };
-                write!(f, "\n| {name}: {what} |")?;
-                for m in ms {
+                write!(f, "\n| {}: {what} |", kind.name())?;
+                for m in methods(kind) {
                     let m = m.name();
                     if uv {
                         write!(f, " {m} t | {m} u,v |")?;
@@ -1227,41 +1217,27 @@ pub mod accuracy {
                     }
                 }
                 f.write_str("\n| --- |")?;
-                for _ in ms {
+                for _ in methods(kind) {
                     f.write_str(if uv { " ---: | ---: |" } else { " ---: |" })?;
                 }
                 f.write_str("\n")?;
                 for (i, c) in classes().enumerate() {
-                    // The first method of each kind admits every case.
-                    let n = table[i][0].cases;
-                    write!(f, "| {} ({n}) |", c.name)?;
-                    for e in &table[i][..ms.len()] {
+                    // Every case of the class (the unit-direction methods admit fewer).
+                    let n = table[i][..n_methods].iter().map(|e| e.cases).max();
+                    write!(f, "| {} ({}) |", c.name, n.unwrap_or(0))?;
+                    for e in &table[i][..n_methods] {
                         let (t, u) = if ratio {
                             (e.t_cond, e.uv_cond)
                         } else {
                             (e.t, e.uv)
                         };
-                        f.write_str(" ")?;
-                        if e.hits == 0 {
-                            f.write_str("–")?;
-                        } else if ratio {
-                            write_ratio(f, t)?;
-                        } else {
-                            write_error(f, t)?;
-                        }
+                        write_cell(f, e, t, ratio)?;
                         if e.wrong > 0 {
                             write!(f, " ({} wrong)", e.wrong)?;
                         }
                         f.write_str(" |")?;
                         if uv {
-                            f.write_str(" ")?;
-                            if e.hits == 0 {
-                                f.write_str("–")?;
-                            } else if ratio {
-                                write_ratio(f, u)?;
-                            } else {
-                                write_error(f, u)?;
-                            }
+                            write_cell(f, e, u, ratio)?;
                             f.write_str(" |")?;
                         }
                     }

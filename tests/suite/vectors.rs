@@ -3,7 +3,8 @@
 
 use raylane::vectors::{self, Case, Digest, Kind, Method, Outcome, Verdict};
 
-const FILES: &[(&str, &str)] = &[
+/// Every vector file: (stem, text).
+pub(crate) const FILES: &[(&str, &str)] = &[
     (
         "sphere_lecture",
         include_str!("../vectors/sphere_lecture.txt"),
