@@ -2092,18 +2092,24 @@ def gen_sphere_huge():
     ], out, mk, per_case_note=cond_range)
 
 
+def plane_case(rng, o, w, n, T, want, idx):
+    """The ray from o along the unit w against the plane with unit normal n through a point at
+    T along the ray (at -T, behind the origin, for a miss), moved by up to 5 within the plane;
+    directions and normals alternate unit / non-unit."""
+    e1, e2 = plane_frame(rng, n)
+    p = vadd(vadd(o, vscale(T if want else -T, w)), vadd(vscale(rng.uniform(-5, 5), e1), vscale(rng.uniform(-5, 5), e2)))
+    d = dir32(rng, w, idx % 2 == 0)
+    nn = dir32(rng, n, (idx // 2) % 2 == 0)
+    return list(o) + list(d) + list(v32(p)) + list(nn)
+
+
 def gen_plane_grazing():
     def make(rng, e, want, idx):
         o = v32(rand_box(rng, 10))
         w = rand_unit(rng)
         g = float(mp.power(2, -e - rng.random()))
         n = tilted(rng, w, g)
-        T = rng.uniform(1.0, 20.0)
-        e1, e2 = plane_frame(rng, n)
-        p = vadd(vadd(o, vscale(T if want else -T, w)), vadd(vscale(rng.uniform(-5, 5), e1), vscale(rng.uniform(-5, 5), e2)))
-        d = dir32(rng, w, idx % 2 == 0)
-        nn = dir32(rng, n, (idx // 2) % 2 == 0)
-        return list(o) + list(d) + list(v32(p)) + list(nn)
+        return plane_case(rng, o, w, n, rng.uniform(1.0, 20.0), want, idx)
     strata = [("cos in [2^-%d, 2^-%d)" % (e + 1, e), e, 8, 2) for e in range(0, 10)]
     return acc_file("plane", "plane_grazing.txt", [
         "accuracy class 'grazing': rays nearly parallel to the plane, cos(ray, normal) from 1 down to",
@@ -2119,12 +2125,7 @@ def gen_plane_offset():
         o = v32(vadd(OFF, rand_box(rng, 100)))
         w = rand_unit(rng)
         n = tilted(rng, w, rng.uniform(0.1, 1.0))
-        T = rng.uniform(1.0, 50.0)
-        e1, e2 = plane_frame(rng, n)
-        p = vadd(vadd(o, vscale(T if want else -T, w)), vadd(vscale(rng.uniform(-5, 5), e1), vscale(rng.uniform(-5, 5), e2)))
-        d = dir32(rng, w, idx % 2 == 0)
-        nn = dir32(rng, n, (idx // 2) % 2 == 0)
-        return list(o) + list(d) + list(v32(p)) + list(nn)
+        return plane_case(rng, o, w, n, rng.uniform(1.0, 50.0), want, idx)
     strata = [("offset 1e5", None, 60, 20)]
     return acc_file("plane", "plane_offset.txt", [
         "accuracy class 'offset': large coordinates.  Origin and plane point near (1e5, 1e5, 1e5)",
