@@ -69,7 +69,7 @@
 use glam::Vec3;
 
 use super::exact;
-use super::{Cull, Triangle, resolve};
+use super::{Cull, Triangle, in_front, within};
 use crate::hit::{self, Hit, HitRecord, LaneHit};
 use crate::lane::{Lane, Mask, Scalar};
 use crate::ray::{Ray, RayPacket};
@@ -89,7 +89,7 @@ const LIMIT: f64 = 1.0e36;
 /// against many.
 #[derive(Clone, Copy, Debug)]
 pub struct FocalTriangle<L: Lane> {
-    /// `A′ × B′`, `B′ × C′`, `C′ × A′` in f32.
+    /// `A′ × B′`, `B′ × C′`, `C′ × A′`, each component rounded once from its exact value.
     n_ab: V3<L>,
     n_bc: V3<L>,
     n_ca: V3<L>,
@@ -97,12 +97,16 @@ pub struct FocalTriangle<L: Lane> {
     k_ab: L,
     k_bc: L,
     k_ca: L,
-    /// `A′·(B′ × C′)`, rounded from its exact value.
+    /// The plane normal `N = (B′ − A′) × (C′ − A′)`, each component rounded once from its
+    /// exact value.
+    n: V3<L>,
+    /// `A′·(B′ × C′)` (`= N·A′`), rounded from its exact value.
     v: L,
-    /// `A′`, `B′`, `C′`, for the exact fallback.
+    /// `A`, `B`, `C` and the eye `E`, for the exact fallback.
     a: V3<L>,
     b: V3<L>,
     c: V3<L>,
+    e: V3<L>,
 }
 
 /// Rounds toward +inf.
@@ -115,19 +119,21 @@ fn wide(v: V3<f32>) -> [f64; 3] {
     [v.x as f64, v.y as f64, v.z as f64]
 }
 
-/// The rounding bound of `fl(D·fl(p × q))` against `D·(p × q)` for `max|D_i| < D_MAX`:
-/// `D_MAX·(γ2·Σ(|p_j q_k| + |p_k q_j|) + γ3·Σ|n_i|)`, padded, plus an underflow term.
-fn bound(p: [f64; 3], q: [f64; 3], n: V3<f32>) -> f64 {
-    let g2 = 2.0 * U / (1.0 - 2.0 * U);
+/// `(p − e) × (q − e)` of `f32` vectors, each component summed exactly and correctly rounded
+/// to `f32`. Twins are exact negations: swapping `p` and `q` negates the exact value, and
+/// rounding to nearest is symmetric.
+fn cross_rel(e: [f64; 3], p: [f64; 3], q: [f64; 3]) -> V3<f32> {
+    let c = |j: usize, k: usize| exact::cross_rel(e, p, q, j, k).round_f32();
+    V3::new(c(1, 2), c(2, 0), c(0, 1))
+}
+
+/// The bound on `|fl(D·n) − D·n*|` for `n` rounded from the exact `n*` ([`cross_rel`]) and
+/// `max|D_i| < D_MAX`: `γ3·Σ|D_i n_i|` for the dot product plus `Σ|D_i|·|n_i − n*_i|`,
+/// at most `D_MAX·(γ3 + 1.0001·2^-24)·Σ|n_i|`; padded, plus an underflow term.
+fn bound(n: V3<f32>) -> f64 {
     let g3 = 3.0 * U / (1.0 - 3.0 * U);
-    let m = (p[1] * q[2]).abs()
-        + (p[2] * q[1]).abs()
-        + (p[2] * q[0]).abs()
-        + (p[0] * q[2]).abs()
-        + (p[0] * q[1]).abs()
-        + (p[1] * q[0]).abs();
     let s = (n.x as f64).abs() + (n.y as f64).abs() + (n.z as f64).abs();
-    D_MAX * (g2 * m + g3 * s) * (1.0 + 1.0e-12) + 1.0e-42
+    D_MAX * (g3 + 1.0001 * U) * s * (1.0 + 1.0e-12) + 1.0e-42
 }
 
 impl FocalTriangle<f32> {
@@ -142,10 +148,12 @@ impl FocalTriangle<f32> {
             k_ab: f32::INFINITY,
             k_bc: f32::INFINITY,
             k_ca: f32::INFINITY,
+            n: nan,
             v: f32::NAN,
             a: nan,
             b: nan,
             c: nan,
+            e: nan,
         }
     }
 
@@ -163,24 +171,26 @@ impl FocalTriangle<f32> {
         if !eye.is_finite() || !Triangle::new(a, b, c).is_valid() {
             return Self::never();
         }
-        // 1. Vertices relative to the eye, rounded once.
-        let e = V3::<f32>::from(eye);
-        let (a, b, c) = (V3::from(a) - e, V3::from(b) - e, V3::from(c) - e);
-        let (wa, wb, wc) = (wide(a), wide(b), wide(c));
-        if exact::collinear(wa, wb, wc) {
-            return Self::never();
-        }
-        // 2. Edge-plane normals in f32 (twins are exact negations) and their rounding bounds.
-        let (n_ab, n_bc, n_ca) = (a.cross(b), b.cross(c), c.cross(a));
-        let (k_ab, k_bc, k_ca) = (
-            bound(wa, wb, n_ab),
-            bound(wb, wc, n_bc),
-            bound(wc, wa, n_ca),
+        let (we, wa, wb, wc) = (
+            wide(eye.into()),
+            wide(a.into()),
+            wide(b.into()),
+            wide(c.into()),
         );
-        // 3. V = A′·(B′ × C′), exact then rounded (its sign is exact).
-        let v = exact::triple(wa, wb, wc).approx();
+        // 1. Edge-plane normals (A − E) × (B − E)…, exact then rounded (twins are exact
+        //    negations), and the rounding bounds of the edge values.
+        let (n_ab, n_bc, n_ca) = (
+            cross_rel(we, wa, wb),
+            cross_rel(we, wb, wc),
+            cross_rel(we, wc, wa),
+        );
+        let (k_ab, k_bc, k_ca) = (bound(n_ab), bound(n_bc), bound(n_ca));
+        // 2. The plane normal N = (B − A) × (C − A) and V = N·(A − E), exact then rounded
+        //    (the sign of V is exact).
+        let n = cross_rel(wa, wb, wc);
+        let v = exact::det_rel(we, wa, wb, wc).round_f32();
         let fits = |n: V3<f32>| [n.x, n.y, n.z].iter().all(|x| (*x as f64).abs() <= LIMIT);
-        let ok = fits(n_ab) && fits(n_bc) && fits(n_ca) && v.abs() <= LIMIT;
+        let ok = fits(n_ab) && fits(n_bc) && fits(n_ca) && fits(n) && (v as f64).abs() <= LIMIT;
         if !ok || k_ab.max(k_bc).max(k_ca) > LIMIT {
             return Self::never();
         }
@@ -191,10 +201,12 @@ impl FocalTriangle<f32> {
             k_ab: up(k_ab),
             k_bc: up(k_bc),
             k_ca: up(k_ca),
-            v: v as f32,
-            a,
-            b,
-            c,
+            n,
+            v,
+            a: a.into(),
+            b: b.into(),
+            c: c.into(),
+            e: eye.into(),
         }
     }
 }
@@ -212,10 +224,12 @@ impl<L: Lane> FocalTriangle<L> {
             k_ab: L::from_f32(e.k_ab),
             k_bc: L::from_f32(e.k_bc),
             k_ca: L::from_f32(e.k_ca),
+            n: v(e.n),
             v: L::from_f32(e.v),
             a: v(e.a),
             b: v(e.b),
             c: v(e.c),
+            e: v(e.e),
         }
     }
 
@@ -233,10 +247,12 @@ impl<L: Lane> FocalTriangle<L> {
             k_ab: s(|e| e.k_ab),
             k_bc: s(|e| e.k_bc),
             k_ca: s(|e| e.k_ca),
+            n: v(|e| e.n),
             v: s(|e| e.v),
             a: v(|e| e.a),
             b: v(|e| e.b),
             c: v(|e| e.c),
+            e: v(|e| e.e),
         }
     }
 
@@ -260,10 +276,12 @@ pub(crate) trait FocalTriangleLanes<L: Lane> {
     fn normals(&self) -> (V3<L>, V3<L>, V3<L>);
     /// `k_ab`, `k_bc`, `k_ca` in lanes.
     fn bounds(&self) -> (L, L, L);
+    /// `N` in lanes.
+    fn normal(&self) -> V3<L>;
     /// `V` in lanes.
     fn v(&self) -> L;
-    /// `A′`, `B′`, `C′` of lane `i` in `f64` (exact), for the exact fallback.
-    fn vertices(&self, i: usize) -> [[f64; 3]; 3];
+    /// `A`, `B`, `C` and the eye `E` of lane `i` in `f64` (exact), for the exact fallback.
+    fn vertices(&self, i: usize) -> [[f64; 3]; 4];
 }
 
 impl<L: Lane> FocalTriangleLanes<L> for FocalTriangle<L> {
@@ -276,11 +294,15 @@ impl<L: Lane> FocalTriangleLanes<L> for FocalTriangle<L> {
         (self.k_ab, self.k_bc, self.k_ca)
     }
     #[inline(always)]
+    fn normal(&self) -> V3<L> {
+        self.n
+    }
+    #[inline(always)]
     fn v(&self) -> L {
         self.v
     }
     #[inline(always)]
-    fn vertices(&self, i: usize) -> [[f64; 3]; 3] {
+    fn vertices(&self, i: usize) -> [[f64; 3]; 4] {
         let w = |v: V3<L>| {
             [
                 v.x.lane(i).to_f64(),
@@ -288,7 +310,7 @@ impl<L: Lane> FocalTriangleLanes<L> for FocalTriangle<L> {
                 v.z.lane(i).to_f64(),
             ]
         };
-        [w(self.a), w(self.b), w(self.c)]
+        [w(self.a), w(self.b), w(self.c), w(self.e)]
     }
 }
 
@@ -313,13 +335,17 @@ impl<L: Lane> FocalTriangleLanes<L> for Splat<'_> {
         )
     }
     #[inline(always)]
+    fn normal(&self) -> V3<L> {
+        V3::splat(self.0.n.into())
+    }
+    #[inline(always)]
     fn v(&self) -> L {
         L::from_f32(self.0.v)
     }
     #[inline(always)]
-    fn vertices(&self, _i: usize) -> [[f64; 3]; 3] {
+    fn vertices(&self, _i: usize) -> [[f64; 3]; 4] {
         let e = self.0;
-        [wide(e.a), wide(e.b), wide(e.c)]
+        [wide(e.a), wide(e.b), wide(e.c), wide(e.e)]
     }
 }
 
@@ -344,6 +370,72 @@ pub struct FocalRays<L: Lane> {
     pub(crate) unit: V3<L>,
 }
 
+/// The largest `f32` at most `x` (`−inf` below `−f32::MAX`, NaN for NaN).
+fn floor32(x: f64) -> f32 {
+    let y = x as f32;
+    if (y as f64) > x { y.next_down() } else { y }
+}
+
+/// The smallest `f32` at least `x`.
+fn ceil32(x: f64) -> f32 {
+    let y = x as f32;
+    if (y as f64) < x { y.next_up() } else { y }
+}
+
+/// The interval `(t_min, t_max)` of a ray in the units of its direction scaled by a power of
+/// two `s = 1/inv`: the open interval of the `f32` values `x` whose own-unit parameter
+/// `fl(x·s)` (one rounding to `f32`) lies strictly inside `(t_min, t_max)`, so never `±inf`.
+/// `x·s` is exact unless it over- or underflows, so this is `(t_min·inv, t_max·inv)` in the
+/// normal range; at the ends it leaves out the scaled `t` that would come back infinite or
+/// round onto an end (the rounding boundary between two adjacent `f32` values, ties to even,
+/// is scaled exactly in `f64`).
+fn scaled_interval(t_min: f32, t_max: f32, inv: f64) -> (f32, f32) {
+    // Round-to-nearest boundaries: fl(y) > t_min ⟺ y > b (or y = b when the tie rounds up).
+    let lo = if t_min.is_nan() || t_min == f32::NEG_INFINITY || t_min == f32::INFINITY {
+        t_min
+    } else {
+        let q = t_min.next_up();
+        let (b, tie_up) = if q == f32::INFINITY {
+            (f32::MAX as f64 + half_ulp_max(), true)
+        } else {
+            ((t_min as f64 + q as f64) / 2.0, q.to_bits() & 1 == 0)
+        };
+        // The largest f32 x with fl(x·s) ≤ t_min: x > lo ⟺ fl(x·s) > t_min.
+        let c = b * inv;
+        let x = floor32(c);
+        if tie_up && x as f64 == c {
+            x.next_down()
+        } else {
+            x
+        }
+    };
+    let hi = if t_max.is_nan() || t_max == f32::NEG_INFINITY {
+        t_max
+    } else {
+        // fl(y) < t_max ⟺ y < b (or y = b when the tie rounds down); fl(y) < inf ⟺ y < 2^128 − 2^103.
+        let (b, tie_down) = if t_max == f32::INFINITY {
+            (f32::MAX as f64 + half_ulp_max(), false)
+        } else {
+            let p = t_max.next_down();
+            ((p as f64 + t_max as f64) / 2.0, p.to_bits() & 1 == 0)
+        };
+        // The smallest f32 x with fl(x·s) ≥ t_max: x < hi ⟺ fl(x·s) < t_max.
+        let c = b * inv;
+        let x = ceil32(c);
+        if tie_down && x as f64 == c {
+            x.next_up()
+        } else {
+            x
+        }
+    };
+    (lo, hi)
+}
+
+/// Half an ulp of `f32::MAX` (`2^103`): `f32::MAX + 2^103` is where rounding reaches `inf`.
+fn half_ulp_max() -> f64 {
+    f64::from_bits((1023 + 103) << 52)
+}
+
 /// Powers of two `(s, 1/s)` with `m·s` in `[1, 2)` for `m` in f32's normal range.
 fn pow2_scale(m: f64) -> (f64, f64) {
     let e = ((m.to_bits() >> 52) & 0x7ff) as i32 - 1023;
@@ -354,7 +446,8 @@ fn pow2_scale(m: f64) -> (f64, f64) {
 
 impl<L: Lane> FocalRays<L> {
     /// Prepares `rays` (which must start at the eye of the caches they are tested against):
-    /// 5 mul and 2 cmp for the scaling, 6 mul, 2 add, 1 div, 1 sqrt for the unit direction.
+    /// 3 mul and 2 cmp for the scaling, 6 mul, 2 add, 1 div, 1 sqrt for the unit direction;
+    /// the power of two and the scaled interval are found per lane in `f64` (not counted).
     #[inline]
     #[must_use]
     pub fn new(rays: &RayPacket<L>) -> Self {
@@ -364,21 +457,26 @@ impl<L: Lane> FocalRays<L> {
         let m = L::select(ax.ge(ay), ax, ay);
         let m = L::select(m.ge(az), m, az);
         let mut s = [0f64; 16];
-        let mut inv = [0f64; 16];
+        let mut lo = [0f32; 16];
+        let mut hi = [0f32; 16];
         for i in 0..L::LANES {
-            (s[i], inv[i]) = pow2_scale(m.lane(i).to_f64());
+            let inv;
+            (s[i], inv) = pow2_scale(m.lane(i).to_f64());
+            // 2. The interval in the scaled units, such that a scaled t strictly inside comes
+            //    back strictly inside (t_min, t_max) and finite.
+            let (t0, t1) = (rays.t_min.lane(i).to_f64(), rays.t_max.lane(i).to_f64());
+            (lo[i], hi[i]) = scaled_interval(t0 as f32, t1 as f32, inv);
         }
         let scale = L::from_fn(|i| L::Scalar::from_f64(s[i]));
-        let inv = L::from_fn(|i| L::Scalar::from_f64(inv[i]));
-        // 2. Exact scaling of the direction and the interval.
+        // 3. Exact scaling of the direction.
         let dir = d.scale(scale);
         let scaled = RayPacket {
             origin: rays.origin,
             dir,
-            t_min: rays.t_min * inv,
-            t_max: rays.t_max * inv,
+            t_min: L::from_f32_fn(|i| lo[i]),
+            t_max: L::from_f32_fn(|i| hi[i]),
         };
-        // 3. The unit direction.
+        // 4. The unit direction.
         let unit = dir.scale(L::from_f32(1.0) / dir.length_squared().sqrt());
         FocalRays {
             scaled,
@@ -545,11 +643,23 @@ pub(crate) fn maybe_hit<L: Lane, F: FocalTriangleLanes<L>>(
     if mask.none() {
         return None;
     }
-    // 4. |det| = Σ|e| and ±V with the sign of det; the interval, then the one division.
-    let (x_ab, x_ca) = (e_ab.abs(), e_ca.abs());
-    let ad = x_ab + e_bc.abs() + x_ca;
+    // 4. t > 0: ±V with the sign of det (exact).
     let v = f.v();
-    Some(resolve(ray, mask, L::select(front, -v, v), x_ca, x_ab, ad))
+    let num_t = L::select(front, -v, v);
+    let mask = in_front(ray, mask, num_t);
+    if mask.none() {
+        return None;
+    }
+    // 5. |det| = ±D·N from the cached plane normal (Σ|e| where the rounded D·N has not the
+    //    sign of the exact decision); the barycentrics over max(|det|, |e_ca| + |e_ab|), so
+    //    that u + v ≤ 1. The interval, then the one division.
+    let (x_ab, x_ca) = (e_ab.abs(), e_ca.abs());
+    let x_uv = x_ab + x_ca;
+    let dn = ray.dir.dot(f.normal());
+    let det = L::select(front, -dn, dn);
+    let den = L::select(det.gt(L::from_f32(0.0)), det, x_uv + e_bc.abs());
+    let w = L::select(x_uv.gt(den), x_uv, den);
+    Some(within(ray, mask, num_t, den, x_ca, x_ab, w))
 }
 
 /// Decides the `doubtful` lanes with exact edge signs (simulation of simplicity for zeros).
@@ -575,7 +685,7 @@ fn exact_signs<L: Lane, F: FocalTriangleLanes<L>>(
             ray.dir.y.lane(i).to_f64(),
             ray.dir.z.lane(i).to_f64(),
         ];
-        let [a, b, c] = f.vertices(i);
+        let [a, b, c, e] = f.vertices(i);
         let mut signs = [0i32; 3];
         for (k, (p, q)) in [(a, b), (b, c), (c, a)].into_iter().enumerate() {
             let (pos, neg) = certain[k];
@@ -584,8 +694,8 @@ fn exact_signs<L: Lane, F: FocalTriangleLanes<L>>(
             } else if neg.test(i) {
                 -1
             } else {
-                match exact::sign_triple(d, p, q) {
-                    0 if exact::sos_sign(p, q) < 0 => -1,
+                match exact::edge_rel(d, e, p, q).sign() {
+                    0 if exact::sos_sign_rel(e, p, q) < 0 => -1,
                     0 => 1,
                     s => s,
                 }
