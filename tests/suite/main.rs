@@ -5,6 +5,7 @@ mod bad_input;
 mod exact_ref;
 mod focal_accuracy;
 mod focal_precision;
+mod focal_rules;
 mod lanes;
 mod opcount;
 mod readme;
