@@ -2,6 +2,7 @@
 //! which keeps builds quick for each CPU configuration and for the AArch64 run).
 
 mod bad_input;
+mod bunny;
 mod exact_ref;
 mod focal_accuracy;
 mod focal_precision;
