@@ -80,7 +80,7 @@ impl<L: Lane> LaneHit<L> {
     }
 
     /// `u/w`, `v/w` (2 div): the record as callers see it, with `−0` made `+0` in `t`, `u`,
-    /// `v` (see [`plus_zero`]).
+    /// `v` (`x + 0`).
     #[inline(always)]
     #[must_use]
     pub fn normalized(self) -> Self {
@@ -182,7 +182,7 @@ impl<L: Lane> Hit<L> {
     }
 
     /// Divides the winners' barycentrics by their denominators (once per ray), with `−0`
-    /// made `+0` in `t`, `u`, `v` (see [`plus_zero`]).
+    /// made `+0` in `t`, `u`, `v` (`x + 0`).
     #[inline(always)]
     fn finish(mut self) -> Self {
         self.t = plus_zero(self.t);

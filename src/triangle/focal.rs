@@ -3,7 +3,7 @@
 //!
 //! Primary rays of a pinhole camera all start at the eye `E` (lecture 000, "Rays from Focal
 //! Point"). With `A′ = A − E`, `B′ = B − E`, `C′ = C − E` (exact, never rounded), the cache
-//! holds, each component computed exactly from the `f32` inputs ([`exact`](super::exact)
+//! holds, each component computed exactly from the `f32` inputs ([`exact`] module
 //! expansions) and correctly rounded to `f32` once:
 //!
 //! ```text
