@@ -154,12 +154,50 @@ fn wide(v: V3<f32>) -> [f64; 3] {
     [v.x as f64, v.y as f64, v.z as f64]
 }
 
-/// `(p − e) × (q − e)` of `f32` vectors, each component summed exactly and correctly rounded
-/// to `f32`. Twins are exact negations: swapping `p` and `q` negates the exact value, and
-/// rounding to nearest is symmetric.
+/// The exact value of `x ± err` rounded to `f32`, when the whole interval rounds to one value
+/// (rounding is monotone, so the exact value in it rounds there too); `None` when in doubt.
+/// `err` is padded for the rounding of `x ± err` itself.
+fn settled(x: f64, err: f64) -> Option<f32> {
+    let err = err * 1.01 + x.abs() * (4.0 / 9_007_199_254_740_992.0);
+    let (lo, hi) = ((x - err) as f32, (x + err) as f32);
+    (lo == hi).then_some(lo)
+}
+
+/// `(p − e) × (q − e)` of `f32` vectors, each component correctly rounded to `f32` from its
+/// exact value: in `f64` when its error bound settles the rounding (almost always), else from
+/// the exact expansion. Twins are exact negations: swapping `p` and `q` negates the exact
+/// value, and rounding to nearest is symmetric.
 fn cross_rel(e: [f64; 3], p: [f64; 3], q: [f64; 3]) -> V3<f32> {
-    let c = |j: usize, k: usize| exact::cross_rel(e, p, q, j, k).round_f32();
+    let (a, b) = (sub(p, e), sub(q, e));
+    let c = |j: usize, k: usize| {
+        let (x, y) = (a[j] * b[k], a[k] * b[j]);
+        // Two differences, two products and a subtraction, each within 2^-53 relative.
+        settled(x - y, (x.abs() + y.abs()) * (6.0 / 9_007_199_254_740_992.0))
+            .unwrap_or_else(|| exact::cross_rel(e, p, q, j, k).round_f32())
+    };
     V3::new(c(1, 2), c(2, 0), c(0, 1))
+}
+
+/// `det[a − e, b − e, c − e]` correctly rounded to `f32` (fast path in `f64` as [`cross_rel`]).
+fn det_rel(e: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> f32 {
+    let (p, q, r) = (sub(a, e), sub(b, e), sub(c, e));
+    let terms = [
+        p[0] * (q[1] * r[2]),
+        -(p[0] * (q[2] * r[1])),
+        p[1] * (q[2] * r[0]),
+        -(p[1] * (q[0] * r[2])),
+        p[2] * (q[0] * r[1]),
+        -(p[2] * (q[1] * r[0])),
+    ];
+    let x: f64 = terms.iter().sum();
+    let m: f64 = terms.iter().map(|t| t.abs()).sum();
+    // Three differences, two products per term, five additions: within 10·2^-53 of m.
+    settled(x, m * (16.0 / 9_007_199_254_740_992.0))
+        .unwrap_or_else(|| exact::det_rel(e, a, b, c).round_f32())
+}
+
+fn sub(p: [f64; 3], q: [f64; 3]) -> [f64; 3] {
+    [p[0] - q[0], p[1] - q[1], p[2] - q[2]]
 }
 
 /// The bound on `|fl(D·n) − D·n*|` for `n` rounded from the exact `n*` ([`cross_rel`]) and
@@ -192,20 +230,22 @@ impl FocalTriangle<f32> {
         }
     }
 
-    /// The cache entry of `tri` for rays from `eye` (see the [module docs](self)).
-    #[must_use]
-    pub fn new(eye: Vec3, tri: &Triangle) -> Self {
-        Self::from_vertices(eye, tri.a(), tri.b(), tri.c())
-    }
-
     /// The entry of the triangle `a`, `b`, `c` for rays from `eye`. Triangles that share an
     /// edge (the same two vertex positions) get edge normals that are exact negations, which
     /// is what makes shared edges watertight: build every entry from the shared positions.
     #[must_use]
     pub fn from_vertices(eye: Vec3, a: Vec3, b: Vec3, c: Vec3) -> Self {
-        if !eye.is_finite() || !Triangle::new(a, b, c).is_valid() {
+        Self::new(eye, &Triangle::new(a, b, c))
+    }
+
+    /// The cache entry of `tri` for rays from `eye` (see the [module docs](self)).
+    #[must_use]
+    pub fn new(eye: Vec3, tri: &Triangle) -> Self {
+        // A valid `Triangle` has finite vertices and nonzero area (checked when it was made).
+        if !eye.is_finite() || !tri.is_valid() {
             return Self::never();
         }
+        let (a, b, c) = (tri.a(), tri.b(), tri.c());
         let (we, wa, wb, wc) = (
             wide(eye.into()),
             wide(a.into()),
@@ -223,7 +263,7 @@ impl FocalTriangle<f32> {
         // 2. The plane normal N = (B − A) × (C − A) and V = N·(A − E), exact then rounded
         //    (the sign of V is exact).
         let n = cross_rel(wa, wb, wc);
-        let v = exact::det_rel(we, wa, wb, wc).round_f32();
+        let v = det_rel(we, wa, wb, wc);
         let fits = |n: V3<f32>| [n.x, n.y, n.z].iter().all(|x| (*x as f64).abs() <= LIMIT);
         let ok = fits(n_ab) && fits(n_bc) && fits(n_ca) && fits(n) && (v as f64).abs() <= LIMIT;
         if !ok || k_ab.max(k_bc).max(k_ca) > LIMIT {
@@ -829,4 +869,44 @@ pub fn closest_soa<L: Lane>(
 pub fn any_soa<L: Lane>(ray: &Ray, cache: &[FocalTriangle<L>], cull: Cull) -> bool {
     let (r, _) = scaled_ray(ray);
     hit::any_soa(&r, cache, |r, e| maybe_hit(r, e, cull))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::rngs::SmallRng;
+    use rand::{Rng, SeedableRng};
+
+    /// The `f64` fast paths give the correctly rounded exact values, bit for bit, also where
+    /// components nearly cancel (collinear-ish points, large offsets, tiny and huge scales).
+    #[test]
+    fn fast_paths_round_like_the_expansions() {
+        let mut rng = SmallRng::seed_from_u64(7);
+        let mut f = |s: f32| rng.random_range(-1.0..1.0f32) * s;
+        for i in 0..200_000 {
+            let s = [1.0e-20, 1.0e-3, 1.0, 3.0e3, 1.0e5, 1.0e15][i % 6];
+            let e = [f(s), f(s), f(s)].map(|x| x as f64);
+            let p = [f(s), f(s), f(s)].map(|x| x as f64);
+            let q: [f64; 3] = if i % 3 == 0 {
+                // Nearly collinear with e and p: cancelling components.
+                let k = f(1.0);
+                [0, 1, 2].map(|j| ((e[j] + k as f64 * (p[j] - e[j])) as f32) as f64)
+            } else {
+                [f(s), f(s), f(s)].map(|x| x as f64)
+            };
+            let r = [f(s), f(s), f(s)].map(|x| x as f64);
+            let fast = cross_rel(e, p, q);
+            let want = |j, k| exact::cross_rel(e, p, q, j, k).round_f32().to_bits();
+            assert_eq!(
+                [fast.x.to_bits(), fast.y.to_bits(), fast.z.to_bits()],
+                [want(1, 2), want(2, 0), want(0, 1)]
+            );
+            let twin = cross_rel(e, q, p);
+            assert_eq!([twin.x, twin.y, twin.z], [-fast.x, -fast.y, -fast.z]);
+            assert_eq!(
+                det_rel(e, p, q, r).to_bits(),
+                exact::det_rel(e, p, q, r).round_f32().to_bits()
+            );
+        }
+    }
 }
