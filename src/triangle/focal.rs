@@ -77,22 +77,20 @@
 //! maps the interval to the scaled units exactly: the scaled `(t_min, t_max)` holds the `f32`
 //! values whose `t·s`, rounded once, lies strictly inside the ray's interval, so a hit whose
 //! own-unit `t` would overflow to `inf` or round to an end (to `0` for `t_min = 0`) is a miss.
-//! `t` is scaled back by `s` once per query (1 mul per ray), `u`, `v` need nothing.
+//! `t` is scaled back by `s` once per query (per ray), `u`, `v` need nothing.
 //!
 //! **Operation count per lane** (measured by `examples/opcount.rs`): miss 9 mul, 6 add,
 //! 6 cmp; edges passed but the triangle behind the eye 9 mul, 6 add, 8 cmp; a hit with `t`,
 //! `u`, `v` 13 mul, 10 add, 1 div, 13 cmp (`u`, `v`: 2 div once per ray, for the winner). Per
 //! ray and query ([`FocalRays::new`]): 3 mul and 2 cmp for the scaling, 6 mul, 2 add, 1 div,
-//! 1 sqrt for the unit direction that bounding spheres use, and 1 mul to scale `t` back; the
-//! power of two and the interval are found per lane in `f64` (not counted). A doubtful lane
-//! (`|e| ≤ K`) adds an exact predicate per doubtful edge (`f64` expansions of three triple
-//! products, not counted).
+//! 1 sqrt for the unit direction that bounding spheres use, and 1 mul, 1 add to scale `t`
+//! back (the add turns `−0` into `+0`); the power of two and the interval are found per lane
+//! in `f64` (not counted). A doubtful lane (`|e| ≤ K`) adds an exact predicate per doubtful
+//! edge (`f64` expansions of three triple products, not counted).
 //!
 //! **The cache** is 112 bytes per triangle (28 `f32`: the four normals, three bounds, `V`, and
 //! `A`, `B`, `C`, `E` for the exact fallback). Each value is rounded from `f64` with an error
-//! bound, and from the exact expansion where the bound cannot settle the rounding: about
-//! 24 ms per 10^5 triangles and eye on the benchmark machine (the 69k bunny; 88 bytes and
-//! 48 ms before the accurate normals).
+//! bound, and from the exact expansion where the bound cannot settle the rounding (rarely).
 //!
 //! **Requirements and limits.** Rays start exactly at the cache's eye (their origin is not
 //! read). An entry whose normals or `V` exceed `10^36` in magnitude is never hit (a triangle
