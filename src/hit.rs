@@ -21,7 +21,8 @@
 //! [`LaneHit::deferred`]); the loops divide once per ray, for the winner, and every record a
 //! caller sees is normalised.
 //!
-//! Misses are canonical: `t = +inf`, `u = v = 0`, index `u32::MAX`. No record ever holds a NaN.
+//! Misses are canonical: `t = +inf`, `u = v = 0`, index `u32::MAX`. No record ever holds a NaN,
+//! and none holds `−0`: records carry `+0`.
 
 use crate::lane::{Lane, Mask, Scalar, select_indices};
 use crate::ray::{Ray, RayPacket};
@@ -78,13 +79,15 @@ impl<L: Lane> LaneHit<L> {
         }
     }
 
-    /// `u/w`, `v/w` (2 div): the record as callers see it.
+    /// `u/w`, `v/w` (2 div): the record as callers see it, with `−0` made `+0` in `t`, `u`,
+    /// `v` (`x + 0`).
     #[inline(always)]
     #[must_use]
     pub fn normalized(self) -> Self {
         LaneHit {
-            u: self.u / self.w,
-            v: self.v / self.w,
+            t: plus_zero(self.t),
+            u: plus_zero(self.u / self.w),
+            v: plus_zero(self.v / self.w),
             w: L::from_f32(1.0),
             ..self
         }
@@ -178,14 +181,26 @@ impl<L: Lane> Hit<L> {
         select_indices::<L>(take, index, &mut self.index);
     }
 
-    /// Divides the winners' barycentrics by their denominators (once per ray).
+    /// Divides the winners' barycentrics by their denominators (once per ray), with `−0`
+    /// made `+0` in `t`, `u`, `v` (`x + 0`).
     #[inline(always)]
     fn finish(mut self) -> Self {
-        self.u = self.u / self.w;
-        self.v = self.v / self.w;
+        self.t = plus_zero(self.t);
+        self.u = plus_zero(self.u / self.w);
+        self.v = plus_zero(self.v / self.w);
         self.w = L::from_f32(1.0);
         self
     }
+}
+
+/// `x + 0`: `−0` becomes `+0` (IEEE round-to-nearest), every other value (NaN aside) is
+/// unchanged. Kernels that fold a sign into their numerators (`select(back, −x, x)`) return
+/// `−0` for a zero barycentric on a back face, or for `t = 0`; records carry `+0`, so that
+/// `u == 0.0` and the bits agree whichever side a ray comes from. One add per field, at the
+/// one place records are made (never in a kernel's counted path).
+#[inline(always)]
+fn plus_zero<L: Lane>(x: L) -> L {
+    x + L::from_f32(0.0)
 }
 
 /// Lanes of `h` strictly closer than `best` (ties keep the earlier, lower-index hit).

@@ -11,6 +11,11 @@
 //! constants, and the exact zero-area test of [`Triangle::new`](super::Triangle::new). The
 //! inputs must be finite `f32` values (widened to `f64`); every intermediate then stays far
 //! inside `f64`'s normal range (|products| between 2^-450 and 2^385).
+//!
+//! Public so that tests and tools can build exact references from the same arithmetic: a
+//! polynomial in `f32` inputs that is a sum of triple products (a 3×3 determinant of
+//! differences of `f32` vectors expands into such a sum) is [`triple`]s added into one
+//! [`Expansion`] of enough capacity, and [`Expansion::approx`] rounds it.
 
 /// `a + b = x + y` exactly (Knuth's two-sum; no overflow assumed).
 #[inline]
@@ -29,20 +34,44 @@ fn split(a: f64) -> (f64, f64) {
     (hi, a - hi)
 }
 
-/// An exact sum of `f64` terms (at most 16 components).
+/// An exact sum of `f64` terms, at most `N` nonzero components (16 by default; the crate's
+/// own uses need at most 12). A sum that would need more than `N` loses its largest component
+/// (never panics): size `N` for the polynomial at hand.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Expansion {
-    e: [f64; 16],
+pub struct Expansion<const N: usize = 16> {
+    e: [f64; N],
     n: usize,
 }
 
-impl Expansion {
-    pub(crate) fn new() -> Self {
-        Expansion { e: [0.0; 16], n: 0 }
+impl<const N: usize> Default for Expansion<N> {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl<const N: usize> Expansion<N> {
+    /// Zero.
+    #[must_use]
+    pub fn new() -> Self {
+        Expansion { e: [0.0; N], n: 0 }
+    }
+
+    /// Adds every component of `other` exactly.
+    pub fn add_all<const M: usize>(&mut self, other: &Expansion<M>) {
+        for &x in other.e.iter().take(other.n) {
+            self.add(x);
+        }
+    }
+
+    /// Subtracts every component of `other` exactly.
+    pub fn sub_all<const M: usize>(&mut self, other: &Expansion<M>) {
+        for &x in other.e.iter().take(other.n) {
+            self.add(-x);
+        }
     }
 
     /// Adds one `f64` exactly (grow-expansion with zero elimination).
-    pub(crate) fn add(&mut self, b: f64) {
+    pub fn add(&mut self, b: f64) {
         let mut q = b;
         let mut m = 0;
         // In place: component i is read before slot m <= i is written. `get` keeps every
@@ -68,14 +97,15 @@ impl Expansion {
     }
 
     /// Adds `x·p` exactly, for `x` an `f32` value and `p` a product of two `f32` values.
-    pub(crate) fn add_product(&mut self, x: f64, p: f64) {
+    pub fn add_product(&mut self, x: f64, p: f64) {
         let (hi, lo) = split(p);
         self.add(x * hi);
         self.add(x * lo);
     }
 
     /// Sign of the exact sum: -1, 0 or 1.
-    pub(crate) fn sign(&self) -> i32 {
+    #[must_use]
+    pub fn sign(&self) -> i32 {
         match self.n.checked_sub(1).and_then(|top| self.e.get(top)) {
             None => 0,
             Some(&x) if x > 0.0 => 1,
@@ -84,13 +114,46 @@ impl Expansion {
     }
 
     /// The sum rounded (to within a few `f64` ulps; the sign is exact).
-    pub(crate) fn approx(&self) -> f64 {
+    #[must_use]
+    pub fn approx(&self) -> f64 {
         self.e.iter().take(self.n).sum()
+    }
+
+    /// The exact sum correctly rounded to `f32` (to nearest, ties to even): a function of the
+    /// exact value alone, so the negated sum rounds to the exact negation. [`approx`] rounded to
+    /// `f32` is within one step of it; the midpoints between adjacent `f32` values are exact
+    /// in `f64`, and the sign of the sum minus a midpoint settles the step exactly. Beyond
+    /// `f32`'s range: `±inf`.
+    ///
+    /// [`approx`]: Self::approx
+    #[must_use]
+    pub fn round_f32(&self) -> f32 {
+        let y = self.approx() as f32;
+        if !y.is_finite() {
+            return y;
+        }
+        // (neighbour, midpoint to it): below and above.
+        for z in [y.next_down(), y.next_up()] {
+            if !z.is_finite() {
+                continue;
+            }
+            let mid = (y as f64 + z as f64) / 2.0;
+            let mut r = *self;
+            r.add(-mid);
+            let s = r.sign() * if z > y { 1 } else { -1 };
+            // s > 0: the sum is beyond the midpoint towards z; 0: a tie, to the even one.
+            if s > 0 || (s == 0 && z.to_bits() & 1 == 0) {
+                return z;
+            }
+        }
+        y
     }
 }
 
-/// The expansion of the triple product `d·(a × b)` (= det[d, a, b]) of `f32` vectors.
-pub(crate) fn triple(d: [f64; 3], a: [f64; 3], b: [f64; 3]) -> Expansion {
+/// The expansion of the triple product `d·(a × b)` (= det[d, a, b]) of `f32` vectors (widened
+/// to `f64`): at most 12 components.
+#[must_use]
+pub fn triple(d: [f64; 3], a: [f64; 3], b: [f64; 3]) -> Expansion {
     let mut x = Expansion::new();
     x.add_product(d[0], a[1] * b[2]);
     x.add_product(-d[0], a[2] * b[1]);
@@ -102,37 +165,66 @@ pub(crate) fn triple(d: [f64; 3], a: [f64; 3], b: [f64; 3]) -> Expansion {
 }
 
 /// Exact sign of `d·(a × b)` for `f32` vectors.
-pub(crate) fn sign_triple(d: [f64; 3], a: [f64; 3], b: [f64; 3]) -> i32 {
+#[must_use]
+pub fn sign_triple(d: [f64; 3], a: [f64; 3], b: [f64; 3]) -> i32 {
     triple(d, a, b).sign()
 }
 
-/// Exact sign of `p·q − r·s` for `f32` values (both products are exact in `f64`, and a rounded
-/// subtraction keeps the sign of the exact difference).
-#[inline]
-pub(crate) fn sign_2x2(p: f64, q: f64, r: f64, s: f64) -> i32 {
-    let x = p * q - r * s;
-    if x > 0.0 {
-        1
-    } else if x < 0.0 {
-        -1
-    } else {
-        0
+/// Component `(j, k)` of `(p − e) × (q − e)` for `f32` vectors, exactly: the six products
+/// `p_j q_k − p_j e_k − e_j q_k − p_k q_j + p_k e_j + e_k q_j` (the `e_j e_k` terms cancel).
+/// With `e = a`, `p = b`, `q = c` it is the plane normal `(b − a) × (c − a)`.
+#[must_use]
+pub fn cross_rel(e: [f64; 3], p: [f64; 3], q: [f64; 3], j: usize, k: usize) -> Expansion {
+    // (Six components at most; `round_f32` adds one more.)
+    let mut x = Expansion::new();
+    for t in [
+        p[j] * q[k],
+        -(p[j] * e[k]),
+        -(e[j] * q[k]),
+        -(p[k] * q[j]),
+        p[k] * e[j],
+        e[k] * q[j],
+    ] {
+        x.add(t);
     }
+    x
 }
 
-/// The simulation-of-simplicity sign of an edge normal `a × b` (`f32` vectors): the sign of its
-/// first nonzero component, x then y then z (0 when `a × b = 0`). It is the sign of `p·(a × b)`
-/// for the infinitesimal perturbation `p = (ε, ε², ε³)` of a ray direction.
-pub(crate) fn sos_sign(a: [f64; 3], b: [f64; 3]) -> i32 {
-    let x = sign_2x2(a[1], b[2], a[2], b[1]);
-    if x != 0 {
-        return x;
+/// The simulation-of-simplicity sign of the edge normal `(p − e) × (q − e)` (`f32` vectors):
+/// the sign of its first nonzero component, x then y then z (0 when it is zero). It is the
+/// sign of `δ·((p − e) × (q − e))` for the infinitesimal direction `δ = (ε, ε², ε³)`.
+#[must_use]
+pub fn sos_sign_rel(e: [f64; 3], p: [f64; 3], q: [f64; 3]) -> i32 {
+    for (j, k) in [(1, 2), (2, 0), (0, 1)] {
+        let s = cross_rel(e, p, q, j, k).sign();
+        if s != 0 {
+            return s;
+        }
     }
-    let y = sign_2x2(a[2], b[0], a[0], b[2]);
-    if y != 0 {
-        return y;
-    }
-    sign_2x2(a[0], b[1], a[1], b[0])
+    0
+}
+
+/// `d·((p − e) × (q − e)) = det[d, p, q] − det[d, p, e] − det[d, e, q]` for `f32` vectors,
+/// exactly (at most 36 components).
+#[must_use]
+pub fn edge_rel(d: [f64; 3], e: [f64; 3], p: [f64; 3], q: [f64; 3]) -> Expansion<40> {
+    let mut x = Expansion::new();
+    x.add_all(&triple(d, p, q));
+    x.sub_all(&triple(d, p, e));
+    x.sub_all(&triple(d, e, q));
+    x
+}
+
+/// `det[a − e, b − e, c − e] = det[a, b, c] − det[e, b, c] − det[a, e, c] − det[a, b, e]` for
+/// `f32` vectors, exactly (at most 48 components).
+#[must_use]
+pub fn det_rel(e: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Expansion<48> {
+    let mut x = Expansion::new();
+    x.add_all(&triple(a, b, c));
+    x.sub_all(&triple(e, b, c));
+    x.sub_all(&triple(a, e, c));
+    x.sub_all(&triple(a, b, e));
+    x
 }
 
 /// True when three points with finite `f32` coordinates are exactly collinear (zero area):
@@ -163,7 +255,7 @@ fn component_is_zero(aj: f64, ak: f64, bj: f64, bk: f64, cj: f64, ck: f64) -> bo
     }
     // Exactly: b_j c_k − b_j a_k − a_j c_k − b_k c_j + b_k a_j + a_k c_j (the a_j a_k terms
     // cancel).
-    let mut x = Expansion::new();
+    let mut x = Expansion::<16>::new();
     for t in [
         bj * ck,
         -(bj * ak),
@@ -207,8 +299,14 @@ mod tests {
         };
         assert_eq!(a[0], 100_000_002_004_087_734_272.0);
         assert_eq!(sign_triple(d, a, b), exact.signum() as i32);
-        assert_eq!(sos_sign(a, b), 1);
-        assert_eq!(sos_sign(b, a), -1);
+        let o = [0.0; 3];
+        assert_eq!(sos_sign_rel(o, a, b), 1);
+        assert_eq!(sos_sign_rel(o, b, a), -1);
+        // Relative to an eye: d·((a − e) × (b − e)) = 0 for d = a − e exactly representable.
+        let e = w([0.5, 0.25, -1.0]);
+        let p = w([1.5, 1.25, 0.0]);
+        assert_eq!(edge_rel(w([1.0, 1.0, 1.0]), e, p, b).sign(), 0);
+        assert_eq!(det_rel(e, e, p, b).sign(), 0);
     }
 
     #[test]

@@ -4,7 +4,11 @@
 #[cfg(feature = "vectors")]
 mod accuracy;
 mod bad_input;
+mod bunny;
+mod exact_ref;
+mod focal_accuracy;
 mod focal_precision;
+mod focal_rules;
 mod lanes;
 mod opcount;
 mod readme;
