@@ -216,9 +216,10 @@ pub fn edge_rel(d: [f64; 3], e: [f64; 3], p: [f64; 3], q: [f64; 3]) -> Expansion
 }
 
 /// `det[a − e, b − e, c − e] = det[a, b, c] − det[e, b, c] − det[a, e, c] − det[a, b, e]` for
-/// `f32` vectors, exactly (at most 48 components).
+/// `f32` vectors, exactly (at most 48 components, and room for the one more that
+/// [`Expansion::round_f32`] adds).
 #[must_use]
-pub fn det_rel(e: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Expansion<48> {
+pub fn det_rel(e: [f64; 3], a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> Expansion<52> {
     let mut x = Expansion::new();
     x.add_all(&triple(a, b, c));
     x.sub_all(&triple(e, b, c));
