@@ -131,7 +131,6 @@ fn kernel_table_claims_hold() {
 /// error are at most 2× Möller–Trumbore's, it gets no hit/miss wrong, and wherever a 2-ulp move
 /// of the inputs changes `t` by less than 2^-18 (relative) its `t` is within 2^-16.
 #[test]
-#[ignore = "today's focal hits fail it: un-ignore when the accurate focal hit (issue 10, item 1) is merged"]
 fn focal_triangles_as_accurate_as_moller() {
     use raylane::vectors::{self, Kind};
     let mut bad = Vec::new();
