@@ -3,7 +3,8 @@
 //!
 //! * **No panic path.** The panic handler calls a function that exists nowhere, so this binary
 //!   links only if no panic can be reached from any kernel (release, LTO).
-//! * **Hardware square roots.** The disassembly must show `vsqrt.f32`, and no software `sqrtf`.
+//! * **Hardware square roots.** The disassembly must show `vsqrt.f32` (Cortex-M4F/M33) or
+//!   `fsqrt.s` (RISC-V with F), and no software `sqrtf`.
 //! * **Flash size**: `.text` of this binary minus `.text` of `empty` (same runtime).
 #![no_std]
 #![no_main]

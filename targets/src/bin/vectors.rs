@@ -11,8 +11,10 @@
 //! lane width 1 only: the vectors and the scalar runner fit, the packet widths do not.
 //!
 //! Output: `FILE METHOD ... N passed, M failed` per file and method (lane width 1; the other
-//! widths must agree), `digest METHOD xLANES HEX` per method and width, then
-//! `N passed, M failed`. Exits non-zero on any failure.
+//! widths must agree), `digest METHOD xLANES HEX` per method and width, the op-count report
+//! measured on the target (`opcount KERNEL,PATH,MUL,ADD,DIV,SQRT,CMP`, as the host's
+//! `cargo run --example opcount -- --csv`), then `N passed, M failed`. Exits non-zero on any
+//! failure.
 #![no_std]
 #![no_main]
 
@@ -106,6 +108,21 @@ fn main() -> ! {
                 ok = false;
             }
         }
+    }
+    // The op-count report, measured here by the counting lane (on the Cortex-M0 with plain
+    // atomic loads and stores): equal to the host's `opcount --csv`.
+    for r in raylane::opcount::table() {
+        let c = r.counts;
+        hprintln!(
+            "opcount {},{},{},{},{},{},{}",
+            r.kernel,
+            r.path,
+            c.mul,
+            c.add,
+            c.div,
+            c.sqrt,
+            c.cmp
+        );
     }
     hprintln!("{} passed, {} failed", passed, failed);
     exit(ok && failed == 0)
