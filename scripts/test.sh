@@ -3,20 +3,32 @@
 #
 #   ./scripts/test.sh
 #
-# 1. Installs what it needs (Debian packages for QEMU and the cross linkers, rustup targets).
-# 2. Formatting and clippy over the workspace.
-# 3. The host test suite (x86-64 baseline), the checker over every vector file with every
+# 1. Installs what it needs, idempotently: Debian packages (QEMU for Arm and RISC-V, the
+#    AArch64 cross linker, Arm and RISC-V binutils), rustup targets, and the MSRV toolchain
+#    (Cargo.toml's rust-version) with the minimal profile.
+# 2. Formatting, clippy over the workspace, rustdoc.
+# 3. The library builds for the host, AArch64, thumbv6m (Cortex-M0), thumbv7m (Cortex-M3),
+#    thumbv7em (M4F), thumbv8m.main (M33), riscv32imac and riscv32imafc, with no default
+#    features and with each feature.
+# 4. MSRV: the library built and its test suite run with the rust-version toolchain.
+# 5. The host test suite (x86-64 baseline), the checker over every vector file with every
 #    method at every lane width, and the baseline digests of every method and width.
-# 4. The host suite again built for x86-64-v3 (AVX2, FMA) and for the native CPU (AVX-512
+# 6. The host suite again built for x86-64-v3 (AVX2, FMA) and for the native CPU (AVX-512
 #    here); their digests must equal the baseline.
-# 5. The whole suite for aarch64-unknown-linux-gnu under qemu-aarch64 (wide's NEON path), and
+# 7. The whole suite for aarch64-unknown-linux-gnu under qemu-aarch64 (wide's NEON path), and
 #    its digests.
-# 6. The firmware under targets/ on QEMU's mps2-an386 (Cortex-M4F) and mps2-an505 (Cortex-M33):
-#    every vector through every method and width, and their digests.
-# 7. Firmware checks: the kernels link with a panic handler that does not exist (no panic
-#    path), their square roots are `vsqrt.f32`, and their flash size.
-# 8. The demo's scene 4 rendered by the firmware on both boards (scalar lane, written to the
+# 8. The firmware under targets/ on six QEMU boards: micro:bit (Cortex-M0; every vector at
+#    lane width 1, the flash holding no more), mps2-an385 (Cortex-M3, soft float), mps2-an386
+#    (Cortex-M4F), mps2-an505 (Cortex-M33), and RISC-V 32 `virt` soft float (rv32imac) and
+#    hard float (rv32imafc): every vector through every method and width, digests equal to
+#    x86-64's, and the op-count report measured on the target equal to the host's.
+# 9. Firmware checks: the kernels link with a panic handler that does not exist (no panic
+#    path) on every target; square roots are `vsqrt.f32` (M4F, M33) and `fsqrt.s`
+#    (rv32imafc) with no software sqrtf; code size per target (scalar kernels, and with
+#    4-lane packets).
+# 10. The demo's scene 4 rendered by the firmware on five boards (scalar lane, written to the
 #    host through semihosting) equals the host's render at every packet width, byte for byte.
+# 11. A summary: every configuration with its digest, code size and run time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -24,27 +36,52 @@ start=$SECONDS
 step() { printf '\n== %s  [%ss]\n' "$*" "$((SECONDS - start))"; }
 fail() { printf '\nFAILED: %s\n' "$*" >&2; exit 1; }
 
-step "system packages and rustup targets"
+step "system packages, rustup targets, MSRV toolchain"
 need=()
 command -v qemu-system-arm >/dev/null || need+=(qemu-system-arm)
+command -v qemu-system-riscv32 >/dev/null || need+=(qemu-system-misc)
 command -v qemu-aarch64 >/dev/null || need+=(qemu-user)
 command -v aarch64-linux-gnu-gcc >/dev/null || need+=(gcc-aarch64-linux-gnu)
 [ -e /usr/aarch64-linux-gnu/lib/crt1.o ] || need+=(libc6-dev-arm64-cross)
 command -v arm-none-eabi-objdump >/dev/null || need+=(binutils-arm-none-eabi)
+command -v riscv64-unknown-elf-objdump >/dev/null || need+=(binutils-riscv64-unknown-elf)
 if [ ${#need[@]} -gt 0 ]; then
   sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
   echo "installing: ${need[*]}"
   $sudo apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
 fi
-rustup target add thumbv7em-none-eabihf thumbv8m.main-none-eabihf aarch64-unknown-linux-gnu 2>&1 | grep -v "is up to date" || true
+embedded=(thumbv6m-none-eabi thumbv7m-none-eabi thumbv7em-none-eabihf thumbv8m.main-none-eabihf
+  riscv32imac-unknown-none-elf riscv32imafc-unknown-none-elf)
+rustup target add "${embedded[@]}" aarch64-unknown-linux-gnu 2>&1 | grep -v "is up to date" || true
 rustup component add rustfmt clippy 2>&1 | grep -v "is up to date" || true
+msrv=$(awk -F'"' '/^rust-version/ { print $2; exit }' Cargo.toml)
+rustup toolchain list | grep -q "^$msrv-" \
+  || rustup toolchain install "$msrv" --profile minimal --no-self-update 2>&1 | tail -n 1
 
 step "format and lints"
 cargo fmt --all -- --check
 (cd targets && cargo fmt -- --check)
 cargo clippy --quiet --workspace --all-targets --features raylane/vectors,raylane/demo -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps --features vectors,demo
+
+step "library builds: host, AArch64 and every embedded target; no default features, each feature"
+for t in x86_64-unknown-linux-gnu aarch64-unknown-linux-gnu "${embedded[@]}"; do
+  for f in "" vectors demo vectors,demo; do
+    cargo build --quiet --lib --target "$t" --no-default-features ${f:+--features "$f"} \
+      --target-dir target/matrix || fail "the library does not build for $t with features [$f]"
+  done
+  echo "$t: builds with no default features, vectors, demo, vectors+demo"
+done
+
+step "MSRV: the library built and tested with Rust $msrv"
+for f in "" vectors demo; do
+  cargo "+$msrv" build --quiet --lib --no-default-features ${f:+--features "$f"} --target-dir target/msrv
+done
+cargo "+$msrv" test --quiet -p raylane --features vectors,demo --target-dir target/msrv \
+  > target/msrv.log 2>&1 || { cat target/msrv.log; fail "the tests fail with Rust $msrv"; }
+grep -E '^test result' target/msrv.log | sed "s/^/rust $msrv: /"
+echo "rust $msrv ($(rustc "+$msrv" --version)): the library builds with every feature and its tests pass"
 
 step "host test suite (x86-64)"
 cargo test --quiet --features vectors,demo
@@ -61,12 +98,25 @@ printf '%-20s' "recommended"
 ./target/release/examples/check tests/vectors/*.txt | tail -n 1
 
 mkdir -p target/digests
-./target/release/examples/digest | grep '^digest' > target/digests/x86-64.txt
-same() { # same NAME FILE: FILE's digests equal the baseline's
-  if diff -q "$root/target/digests/x86-64.txt" "$2" >/dev/null; then
+# Run times of the digest runs: "NAME SECONDS" lines.
+: > target/digests/times
+timed() { # timed NAME CMD...: runs CMD, records its wall time under NAME, returns its status
+  local t0 t1 rc=0
+  t0=$(date +%s.%N)
+  "${@:2}" || rc=$?
+  t1=$(date +%s.%N)
+  awk -v n="$1" -v a="$t0" -v b="$t1" 'BEGIN { print n, b - a }' >> "$root/target/digests/times"
+  return "$rc"
+}
+timed x86-64 ./target/release/examples/digest > target/digests/x86-64.log
+grep '^digest' target/digests/x86-64.log > target/digests/x86-64.txt
+same() { # same NAME FILE: FILE's digests equal the baseline's (those of the widths it has)
+  local want
+  want=$(grep -F -f <(awk '{ print " " $3 " " }' "$2" | sort -u) "$root/target/digests/x86-64.txt")
+  if [ "$(wc -l < "$2")" -gt 0 ] && diff -q <(echo "$want") "$2" >/dev/null; then
     echo "$1: $(wc -l < "$2") digests equal to x86-64"
   else
-    diff "$root/target/digests/x86-64.txt" "$2" || true
+    diff <(echo "$want") "$2" || true
     fail "$1 digests differ from x86-64"
   fi
 }
@@ -74,58 +124,95 @@ same() { # same NAME FILE: FILE's digests equal the baseline's
 for cpu in x86-64-v3 native; do
   step "host test suite, -C target-cpu=$cpu"
   RUSTFLAGS="-C target-cpu=$cpu" cargo test --quiet --features vectors,demo --target-dir "target/cpu-$cpu"
-  RUSTFLAGS="-C target-cpu=$cpu" cargo run --quiet --release --features vectors,demo --example digest \
-    --target-dir "target/cpu-$cpu" | grep '^digest' > "target/digests/$cpu.txt"
+  RUSTFLAGS="-C target-cpu=$cpu" cargo build --quiet --release --features vectors,demo --example digest \
+    --target-dir "target/cpu-$cpu"
+  timed "$cpu" "target/cpu-$cpu/release/examples/digest" > "target/digests/$cpu.log"
+  grep '^digest' "target/digests/$cpu.log" > "target/digests/$cpu.txt"
   same "$cpu" "target/digests/$cpu.txt"
 done
 
 step "AArch64 (NEON) test suite under qemu-aarch64"
 cargo test --quiet --release --features vectors,demo --target aarch64-unknown-linux-gnu
-cargo run --quiet --release --features vectors,demo --example digest --target aarch64-unknown-linux-gnu \
-  | grep '^digest' > target/digests/aarch64.txt
+cargo build --quiet --release --features vectors,demo --example digest --target aarch64-unknown-linux-gnu
+timed aarch64 qemu-aarch64 -L /usr/aarch64-linux-gnu \
+  target/aarch64-unknown-linux-gnu/release/examples/digest > target/digests/aarch64.log
+grep '^digest' target/digests/aarch64.log > target/digests/aarch64.txt
 same aarch64 target/digests/aarch64.txt
 
-step "firmware on QEMU: Cortex-M4F (mps2-an386) and Cortex-M33 (mps2-an505)"
+# NAME:TARGET:BOARD of every firmware configuration.
+boards=(cortex-m0:thumbv6m-none-eabi:microbit cortex-m3:thumbv7m-none-eabi:mps2-an385
+  cortex-m4f:thumbv7em-none-eabihf:mps2-an386 cortex-m33:thumbv8m.main-none-eabihf:mps2-an505
+  rv32imac:riscv32imac-unknown-none-elf:virt rv32imafc:riscv32imafc-unknown-none-elf:virt)
+
+step "firmware on QEMU: Cortex-M0, M3, M4F, M33, RISC-V rv32imac and rv32imafc"
+cargo run --quiet --example opcount -- --csv | tail -n +2 > target/digests/opcount.csv
 cd "$root/targets"
-for t in thumbv7em-none-eabihf thumbv8m.main-none-eabihf; do
+# One target at a time: cargo unifies the features of target-specific dependencies across the
+# targets of one invocation (cortex-m's and riscv's critical-section features clash).
+for t in "${embedded[@]}"; do
   cargo build --quiet --release --target "$t" --bins
 done
-for t in thumbv7em-none-eabihf:cortex-m4f thumbv8m.main-none-eabihf:cortex-m33; do
-  target=${t%%:*}; name=${t##*:}
+for b in "${boards[@]}"; do
+  IFS=: read -r name target board <<< "$b"
   log="$root/target/digests/$name.log"
   status=0
-  cargo run --quiet --release --target "$target" --bin vectors > "$log" 2>&1 || status=$?
-  grep -v '^digest' "$log" | grep -E 'FAILED|differs|cannot' || true
-  tail -n 1 "$log" | sed "s/^/$name: /"
+  timed "$name" cargo run --quiet --release --target "$target" --bin vectors > "$log" 2>&1 || status=$?
+  grep -v '^digest' "$log" | grep -E 'FAILED|differs|cannot|panicked' || true
+  tail -n 1 "$log" | sed "s/^/$name ($board): /"
   [ "$status" -eq 0 ] || fail "$name firmware exited with $status (see $log)"
   grep -qE '^[0-9]+ passed, 0 failed$' "$log" || fail "$name firmware printed no result (see $log)"
   grep '^digest' "$log" > "$root/target/digests/$name.txt"
   same "$name" "$root/target/digests/$name.txt"
+  diff <(sed -n 's/^opcount //p' "$log") "$root/target/digests/opcount.csv" \
+    || fail "$name: the op counts measured on the target differ from the host's"
+  echo "$name: op-count report measured on the target equal to the host's ($(wc -l < "$root/target/digests/opcount.csv") rows)"
 done
 
-step "firmware checks: no panic path, hardware square root, flash size"
-m4="target/thumbv7em-none-eabihf/release"
-m33="target/thumbv8m.main-none-eabihf/release"
+step "firmware checks: no panic path, hardware square root, code size"
 # The `kernels` (f32) and `kernels_x4` (f32 and f32x4) binaries' panic handler calls a symbol
 # defined nowhere: they linked, so no kernel can reach a panic.
-echo "no panic path: kernels and kernels_x4 linked for both boards with an undefined panic handler"
-for bin in "$m4/kernels" "$m33/kernels"; do
-  n=$(arm-none-eabi-objdump -d "$bin" | grep -c 'vsqrt\.f32' || true)
-  [ "$n" -gt 0 ] || fail "no vsqrt.f32 in $bin"
-  if arm-none-eabi-nm -C "$bin" | grep -qiE 'sqrtf'; then fail "a software f32 square root is linked in $bin"; fi
-  echo "hardware square root: $n vsqrt.f32 in $bin, no software sqrtf"
+echo "no panic path: kernels and kernels_x4 linked for all six targets with an undefined panic handler"
+tools() { case "$1" in riscv*) echo riscv64-unknown-elf ;; *) echo arm-none-eabi ;; esac; }
+for t in thumbv7em-none-eabihf:vsqrt.f32 thumbv8m.main-none-eabihf:vsqrt.f32 riscv32imafc-unknown-none-elf:fsqrt.s; do
+  target=${t%%:*}; insn=${t##*:}; bin="target/$target/release/kernels"; tp=$(tools "$target")
+  n=$("$tp-objdump" -d "$bin" | grep -c "	${insn//./\\.}" || true)
+  [ "$n" -gt 0 ] || fail "no $insn in $bin"
+  # (grep -c, not grep -q: under pipefail, nm killed by an early exit of grep would fail the pipe)
+  [ "$("$tp-nm" -C "$bin" | grep -ciE 'sqrtf' || true)" -eq 0 ] \
+    || fail "a software f32 square root is linked in $bin"
+  echo "hardware square root: $n $insn in $bin, no software sqrtf"
 done
-text() { arm-none-eabi-size -A -d "$1" | awk '$1==".text"{print $2}'; }
-empty=$(text "$m4/empty")
-echo "flash on Cortex-M4F: every kernel, scalar: $(( $(text "$m4/kernels") - empty )) B of code;" \
-  "with 4-lane packets too: $(( $(text "$m4/kernels_x4") - empty )) B (empty firmware: $empty B)"
+for target in thumbv6m-none-eabi thumbv7m-none-eabi riscv32imac-unknown-none-elf; do
+  [ "$("$(tools "$target")-nm" -C "target/$target/release/kernels" | grep -c 'libm::math::sqrt::sqrtf' || true)" -gt 0 ] \
+    || fail "no libm sqrtf in $target's kernels"
+done
+echo "software square root (libm's correctly rounded sqrtf) on the cores without one: Cortex-M0, M3, rv32imac"
+text() { "$(tools "$2")-size" -A -d "target/$2/release/$1" | awk '$1==".text"{print $2}'; }
+: > "$root/target/digests/sizes"
+{
+  echo "| target | core (QEMU board) | scalar kernels | with 4-lane packets | empty firmware |"
+  echo "| --- | --- | ---: | ---: | ---: |"
+  for b in "${boards[@]}"; do
+    IFS=: read -r name target board <<< "$b"
+    empty=$(text empty "$target")
+    k1=$(( $(text kernels "$target") - empty )); k4=$(( $(text kernels_x4 "$target") - empty ))
+    echo "| \`$target\` | $name ($board) | $k1 B | $k4 B | $empty B |"
+    echo "$name $k1 $k4" >> "$root/target/digests/sizes"
+  done
+} > "$root/target/digests/size.md"
+echo "code size (.text of every kernel, minus the empty firmware's; opt-level s, LTO):"
+cat "$root/target/digests/size.md"
 cd "$root"
 
 step "firmware render vs host render: scene 4 at 64x48, byte for byte"
 mkdir -p target/render
 cd "$root/targets"
-for t in thumbv7em-none-eabihf:cortex-m4f thumbv8m.main-none-eabihf:cortex-m33; do
-  target=${t%%:*}; name=${t##*:}
+renders=()
+for b in "${boards[@]}"; do
+  IFS=: read -r name target board <<< "$b"
+  # The Cortex-M0's 16 KB of RAM cannot hold the 9 KB image beside the scene.
+  [ "$name" != cortex-m0 ] || continue
+  renders+=("$name")
   log="$root/target/render/$name.log"
   rm -f target/render.ppm "$root/target/render/$name.ppm"
   status=0
@@ -139,13 +226,28 @@ cd "$root"
 for lanes in 1 4 8 16; do
   ./target/release/examples/render --scene mix --size 64x48 --lanes "$lanes" \
     --ppm "target/render/host-x$lanes.ppm" | sed 's/^/host: /'
-  for name in cortex-m4f cortex-m33; do
+  for name in "${renders[@]}"; do
     cmp "target/render/host-x$lanes.ppm" "target/render/$name.ppm" \
       || fail "$name render differs from the host's at $lanes lanes"
   done
 done
-echo "firmware images equal to the host's at 1, 4, 8 and 16 lanes ($(wc -c < target/render/cortex-m4f.ppm) bytes)"
+echo "firmware images (${renders[*]}) equal to the host's at 1, 4, 8 and 16 lanes ($(wc -c < target/render/cortex-m4f.ppm) bytes)"
 
-step "digests"
-for f in target/digests/*.txt; do printf '%-12s %s\n' "$(basename "$f" .txt)" "$(md5sum < "$f" | cut -c1-16)"; done
+step "summary: every configuration, its digest, code size and digest run time"
+# The digest: the first 16 hex digits of the MD5 of the configuration's digest lines (the
+# Cortex-M0 has the x1 lines only: compare it with x86-64 x1).
+h() { md5sum < "$1" | cut -c1-16; }
+grep ' x1 ' target/digests/x86-64.txt > target/digests/x86-64-x1.txt
+printf '%-11s %-30s %-17s %-17s %-22s %s\n' config target "digest (all)" "digest (x1)" "code: x1 / x4 (B)" "run (s)"
+for c in "x86-64:x86_64 (baseline)" "x86-64-v3:x86_64 cpu=x86-64-v3" "native:x86_64 cpu=native" \
+         "aarch64:aarch64 (qemu-aarch64)" \
+         "${boards[@]}"; do
+  IFS=: read -r name target _ <<< "$c"
+  f=target/digests/$name.txt
+  all=$(h "$f"); [ "$(wc -l < "$f")" -eq 40 ] || all="(x1 only)"
+  x1=$(grep ' x1 ' "$f" | md5sum | cut -c1-16)
+  size=$(awk -v n="$name" '$1 == n { print $2 " / " $3 }' target/digests/sizes 2>/dev/null)
+  run=$(awk -v n="$name" '$1 == n { printf "%.2f", $2 }' target/digests/times)
+  printf '%-11s %-30s %-17s %-17s %-22s %s\n' "$name" "$target" "$all" "$x1" "${size:--}" "$run"
+done
 printf '\nall tests passed in %ss\n' "$((SECONDS - start))"

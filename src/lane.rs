@@ -114,6 +114,61 @@ impl Mask for bool {
     }
 }
 
+/// The most lanes a [`Lane`] type may have: 16 (`wide::f32x16`).
+///
+/// Lane-sized scratch arrays (in [`V3::from_fn`](crate::vec3::V3::from_fn),
+/// [`TrianglePacket::from_fn`](crate::triangle::TrianglePacket::from_fn),
+/// [`FocalRays::new`](crate::triangle::FocalRays::new), the vector runner and the demo) have
+/// this length, and each of them checks `L::LANES <= MAX_LANES` at compile time
+/// ([`assert_fits`]): a wider lane type is a compile error, never a wrong result.
+///
+/// ```compile_fail,E0080
+/// # use raylane::{Lane, V3, lane::MAX_LANES};
+/// # use glam::Vec3;
+/// // A 32-lane type (here a scalar that claims 32 lanes) is refused where lanes are gathered.
+/// #[derive(Clone, Copy, Debug)]
+/// struct Wide32(f32);
+/// # use core::ops::*;
+/// # impl Add for Wide32 { type Output = Self; fn add(self, o: Self) -> Self { Wide32(self.0 + o.0) } }
+/// # impl Sub for Wide32 { type Output = Self; fn sub(self, o: Self) -> Self { Wide32(self.0 - o.0) } }
+/// # impl Mul for Wide32 { type Output = Self; fn mul(self, o: Self) -> Self { Wide32(self.0 * o.0) } }
+/// # impl Div for Wide32 { type Output = Self; fn div(self, o: Self) -> Self { Wide32(self.0 / o.0) } }
+/// # impl Neg for Wide32 { type Output = Self; fn neg(self) -> Self { Wide32(-self.0) } }
+/// impl Lane for Wide32 {
+///     const LANES: usize = 32;
+///     // ... every other item as for f32 ...
+/// #   type Scalar = f32; type Mask = bool; type Precise = f64; type Indices = [u32; 1];
+/// #   fn splat(x: f32) -> Self { Wide32(x) }
+/// #   fn sqrt(self) -> Self { self }
+/// #   fn lt(self, r: Self) -> bool { self.0 < r.0 }
+/// #   fn le(self, r: Self) -> bool { self.0 <= r.0 }
+/// #   fn gt(self, r: Self) -> bool { self.0 > r.0 }
+/// #   fn ge(self, r: Self) -> bool { self.0 >= r.0 }
+/// #   fn select(m: bool, a: Self, b: Self) -> Self { if m { a } else { b } }
+/// #   fn abs(self) -> Self { self }
+/// #   fn is_finite(self) -> bool { true }
+/// #   fn lane(self, _: usize) -> f32 { self.0 }
+/// #   fn from_fn(mut f: impl FnMut(usize) -> f32) -> Self { Wide32(f(0)) }
+/// #   fn indices(v: u32) -> [u32; 1] { [v] }
+/// #   fn precise_lane(self, _: usize) -> f64 { self.0 as f64 }
+/// }
+/// let _ = V3::<Wide32>::from_fn(|_| Vec3::ZERO);
+/// ```
+pub const MAX_LANES: usize = 16;
+
+/// Compile-time check that `L` has at most [`MAX_LANES`] lanes: called by every function that
+/// gathers lanes into a `[_; MAX_LANES]` array, it fails the build (error E0080) when that
+/// function is instantiated with a wider lane type.
+#[inline(always)]
+pub const fn assert_fits<L: Lane>() {
+    const {
+        assert!(
+            L::LANES <= MAX_LANES,
+            "raylane supports at most MAX_LANES (16) lanes per lane type"
+        )
+    }
+}
+
 /// A lane of floating-point values: the type every kernel is generic over.
 ///
 /// Arithmetic (`+ - * /`, [`sqrt`](Lane::sqrt)) and comparisons are the operations a kernel may
@@ -188,18 +243,45 @@ pub trait Lane:
 /// Correctly rounded `f32` square root for the scalar lane.
 ///
 /// x86-64 (`sqrtss`) and AArch64 (`fsqrt`) get the instruction through `libm`; on Cortex-M
-/// with a hard-float FPU the `vsqrt.f32` instruction is used directly (both are IEEE-754
-/// correctly rounded, so all targets agree to the bit).
+/// with a hard-float FPU the `vsqrt.f32` instruction is used directly, and on RISC-V with the
+/// F extension `fsqrt.s`. Cores without a floating-point square root (Cortex-M0/M3, RISC-V
+/// without F) use `libm`'s correctly rounded software root. All of them are IEEE-754
+/// correctly rounded, so all targets agree to the bit.
 #[inline(always)]
 pub fn sqrt_f32(x: f32) -> f32 {
     #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
     {
         arm_vsqrt(x)
     }
-    #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+    #[cfg(all(any(target_arch = "riscv32", target_arch = "riscv64"), raylane_riscv_f))]
+    {
+        riscv_fsqrt(x)
+    }
+    #[cfg(not(any(
+        all(target_arch = "arm", target_abi = "eabihf"),
+        all(any(target_arch = "riscv32", target_arch = "riscv64"), raylane_riscv_f)
+    )))]
     {
         libm::sqrtf(x)
     }
+}
+
+#[cfg(all(any(target_arch = "riscv32", target_arch = "riscv64"), raylane_riscv_f))]
+#[inline(always)]
+fn riscv_fsqrt(x: f32) -> f32 {
+    let root: f32;
+    // SAFETY: fsqrt.s reads and writes only the given float registers and the accrued
+    // exception flags in fcsr; the F extension has it (build.rs sets `raylane_riscv_f` only
+    // then). Rounding: the dynamic mode, round to nearest even unless software changes frm.
+    unsafe {
+        core::arch::asm!(
+            "fsqrt.s {r}, {x}",
+            r = lateout(freg) root,
+            x = in(freg) x,
+            options(pure, nomem, nostack, preserves_flags),
+        );
+    }
+    root
 }
 
 #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
@@ -388,13 +470,19 @@ macro_rules! wide_lane {
             }
             #[inline(always)]
             fn sqrt(self) -> Self {
-                #[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+                #[cfg(any(
+                    all(target_arch = "arm", target_abi = "eabihf"),
+                    all(any(target_arch = "riscv32", target_arch = "riscv64"), raylane_riscv_f)
+                ))]
                 {
                     // wide's portable fallback is a software f64 root; use the FPU per lane.
                     let a = self.to_array();
                     $t::new(core::array::from_fn(|i| sqrt_f32(a[i])))
                 }
-                #[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+                #[cfg(not(any(
+                    all(target_arch = "arm", target_abi = "eabihf"),
+                    all(any(target_arch = "riscv32", target_arch = "riscv64"), raylane_riscv_f)
+                )))]
                 {
                     $t::sqrt(self)
                 }

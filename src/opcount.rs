@@ -7,13 +7,23 @@
 //! ever used one, would count as one multiply and one addition.) Negation, absolute value,
 //! `select` and mask logic are sign or bit operations and are not counted.
 //!
-//! [`measure`] runs a closure with the counters zeroed and returns what it counted; a spin
-//! lock serialises concurrent measurements, so tests may call it from many threads. The
-//! counters are global atomics; nothing here is used by the uncounted lane types.
+//! [`measure`] runs a closure and returns what it counted (the difference of the counters
+//! before and after). The counters are global atomics; nothing here is used by the uncounted
+//! lane types.
+//!
+//! * Where the target has atomic read-modify-write operations (`target_has_atomic = "32"`:
+//!   x86-64, AArch64, Cortex-M3/M4/M7/M33, RISC-V with the A extension), each count is a
+//!   `fetch_add` and a spin lock serialises concurrent measurements, so tests may call
+//!   [`measure`] from many threads. The lock is held by a guard that releases it when dropped,
+//!   so a closure that panics (and unwinds) does not leave it taken.
+//! * Where atomics only load and store (Cortex-M0/M0+, `thumbv6m-none-eabi`), each count is
+//!   a load and a store and there is no lock: such a core runs one thread, so measurements
+//!   cannot overlap (and nested ones simply include the inner counts). Counting from an
+//!   interrupt handler while the main thread counts may lose increments there.
 
 use core::fmt;
 use core::ops::{Add, Div, Mul, Neg, Sub};
-use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use core::sync::atomic::{AtomicU32, Ordering};
 
 use crate::lane::Lane;
 
@@ -79,11 +89,20 @@ static ADD: AtomicU32 = AtomicU32::new(0);
 static DIV: AtomicU32 = AtomicU32::new(0);
 static SQRT: AtomicU32 = AtomicU32::new(0);
 static CMP: AtomicU32 = AtomicU32::new(0);
-static LOCK: AtomicBool = AtomicBool::new(false);
 
+/// One more on counter `c`.
+#[cfg(target_has_atomic = "32")]
 #[inline(always)]
 fn bump(c: &AtomicU32) {
     c.fetch_add(1, Ordering::Relaxed);
+}
+
+/// One more on counter `c`: a load and a store (no read-modify-write on this target; one
+/// thread of execution, see the [module docs](self)).
+#[cfg(not(target_has_atomic = "32"))]
+#[inline(always)]
+fn bump(c: &AtomicU32) {
+    c.store(c.load(Ordering::Relaxed).wrapping_add(1), Ordering::Relaxed);
 }
 
 fn snapshot() -> OpCounts {
@@ -96,20 +115,50 @@ fn snapshot() -> OpCounts {
     }
 }
 
+/// The measurement lock: held by a [`Held`] guard.
+#[cfg(target_has_atomic = "32")]
+static LOCK: core::sync::atomic::AtomicBool = core::sync::atomic::AtomicBool::new(false);
+
+/// Holds the measurement lock; dropping it (also while unwinding) releases the lock.
+struct Held;
+
+impl Held {
+    #[cfg(target_has_atomic = "32")]
+    fn take() -> Held {
+        while LOCK
+            .compare_exchange_weak(false, true, Ordering::Acquire, Ordering::Relaxed)
+            .is_err()
+        {
+            core::hint::spin_loop();
+        }
+        Held
+    }
+
+    /// No lock where atomics only load and store: one thread of execution.
+    #[cfg(not(target_has_atomic = "32"))]
+    fn take() -> Held {
+        Held
+    }
+}
+
+impl Drop for Held {
+    fn drop(&mut self) {
+        #[cfg(target_has_atomic = "32")]
+        LOCK.store(false, Ordering::Release);
+    }
+}
+
 /// Runs `f` and returns its result with the operations it performed on [`Counted`] lanes.
 ///
-/// Measurements are serialised by a spin lock, so concurrent callers do not mix their counts.
+/// Measurements are serialised by a spin lock, so concurrent callers do not mix their counts;
+/// the lock is released when `f` returns or panics. (On targets without atomic
+/// read-modify-write there is no lock: see the [module docs](self).)
 pub fn measure<R>(f: impl FnOnce() -> R) -> (R, OpCounts) {
-    while LOCK
-        .compare_exchange_weak(false, true, Ordering::Acquire, Ordering::Relaxed)
-        .is_err()
-    {
-        core::hint::spin_loop();
-    }
+    let held = Held::take();
     let before = snapshot();
     let r = f();
     let counts = snapshot().minus(&before);
-    LOCK.store(false, Ordering::Release);
+    drop(held);
     (r, counts)
 }
 

@@ -8,7 +8,7 @@ use core::ops::{Add, Neg, Sub};
 
 use glam::Vec3;
 
-use crate::lane::Lane;
+use crate::lane::{Lane, MAX_LANES};
 
 /// Three lanes, one per axis.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -44,9 +44,10 @@ impl<L: Lane> V3<L> {
     #[inline(always)]
     #[must_use]
     pub fn from_fn(mut f: impl FnMut(usize) -> Vec3) -> Self {
-        let mut xs = [0f32; 16];
-        let mut ys = [0f32; 16];
-        let mut zs = [0f32; 16];
+        crate::lane::assert_fits::<L>();
+        let mut xs = [0f32; MAX_LANES];
+        let mut ys = [0f32; MAX_LANES];
+        let mut zs = [0f32; MAX_LANES];
         for i in 0..L::LANES {
             let v = f(i);
             xs[i] = v.x;

@@ -28,7 +28,7 @@ use core::hash::Hasher as _;
 
 use glam::Vec3;
 
-use crate::lane::{Lane, Mask};
+use crate::lane::{Lane, MAX_LANES, Mask};
 use crate::plane::{self, FocalPlane, Plane, PlanePacket};
 use crate::ray::RayPacket;
 use crate::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
@@ -620,6 +620,7 @@ fn run<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome
 
 /// Evaluates up to `L::LANES` cases of one kind in one packet.
 fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome]) {
+    crate::lane::assert_fits::<L>();
     let kind = cases[0].kind;
     if !method.applies(kind) {
         out.iter_mut().for_each(|o| *o = Outcome::default());
@@ -644,7 +645,7 @@ fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outco
                 Method::Focal | Method::FocalUnguarded => {
                     let mut e =
                         [FocalSphere::<f32>::new(Vec3::ZERO, &Sphere::new(Vec3::ZERO, f32::NAN));
-                            16];
+                            MAX_LANES];
                     for (k, c) in cases.iter().enumerate() {
                         e[k] = if method == Method::Focal {
                             FocalSphere::new(c.origin(), &c.sphere())
@@ -708,7 +709,7 @@ fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outco
                 Method::Watertight => tri_lanes::<Watertight, L>(&ray, &tris),
                 _ => {
                     // A per-case cache with the eye at the ray origin.
-                    let mut e = [FocalTriangle::never(); 16];
+                    let mut e = [FocalTriangle::never(); MAX_LANES];
                     for (k, c) in cases.iter().enumerate() {
                         e[k] = FocalTriangle::new(c.origin(), &c.triangle());
                     }
@@ -741,9 +742,9 @@ fn tri_lanes<K: TriangleKernel, L: Lane>(
     K::intersect(ray, &K::prepare(ray), tris, Cull::None).normalized()
 }
 
-fn sphere_list(cases: &[Case]) -> [Sphere; 16] {
-    let mut s = [Sphere::new(Vec3::ZERO, f32::NAN); 16];
-    for (k, c) in cases.iter().enumerate().take(16) {
+fn sphere_list(cases: &[Case]) -> [Sphere; MAX_LANES] {
+    let mut s = [Sphere::new(Vec3::ZERO, f32::NAN); MAX_LANES];
+    for (k, c) in cases.iter().enumerate().take(MAX_LANES) {
         s[k] = c.sphere();
     }
     s

@@ -1,17 +1,31 @@
-//! Picks memory.x for the board of the target, and embeds every file of ../tests/vectors.
+//! Picks memory.x for the board of the target, and embeds every file of ../tests/vectors,
+//! parsed here by raylane's own parser into a compact binary form (see `raylane_fw::Cases`).
 use std::{env, fmt::Write as _, fs, path::PathBuf};
+
+use raylane::vectors::{self, Case, Kind};
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());
     let target = env::var("TARGET").unwrap();
     let mem = match target.as_str() {
+        "thumbv6m-none-eabi" => "memory/microbit.x", // Cortex-M0
+        "thumbv7m-none-eabi" => "memory/mps2-an385.x", // Cortex-M3
         "thumbv7em-none-eabihf" => "memory/mps2-an386.x", // Cortex-M4F
         "thumbv8m.main-none-eabihf" => "memory/mps2-an505.x", // Cortex-M33
+        "riscv32imac-unknown-none-elf" | "riscv32imafc-unknown-none-elf" => "memory/riscv-virt.x",
         t => panic!(
-            "raylane-fw: no board for target {t}; use thumbv7em-none-eabihf or thumbv8m.main-none-eabihf"
+            "raylane-fw: no board for target {t}; use thumbv6m-none-eabi, thumbv7m-none-eabi, \
+             thumbv7em-none-eabihf, thumbv8m.main-none-eabihf, riscv32imac-unknown-none-elf \
+             or riscv32imafc-unknown-none-elf"
         ),
     };
     fs::copy(mem, out.join("memory.x")).unwrap();
+    // The micro:bit's 256 KB of flash hold every vector and the scalar (x1) runner, not the
+    // packet widths too: `vectors` runs x1 only there (`scalar_only`).
+    println!("cargo::rustc-check-cfg=cfg(scalar_only)");
+    if target == "thumbv6m-none-eabi" {
+        println!("cargo::rustc-cfg=scalar_only");
+    }
     println!("cargo:rustc-link-search={}", out.display());
     println!("cargo:rerun-if-changed={mem}");
     println!("cargo:rerun-if-changed=build.rs");
@@ -27,18 +41,48 @@ fn main() {
         .collect();
     files.sort();
     let mut src = String::from(
-        "/// Every vector file: (name, text), in name order.\npub static FILES: &[(&str, &str)] = &[\n",
+        "/// Every vector file: (name, encoded cases), in name order.\n\
+         pub static FILES: &[(&str, raylane_fw::Cases)] = &[\n",
     );
     for p in &files {
         println!("cargo:rerun-if-changed={}", p.display());
         let name = p.file_stem().unwrap().to_str().unwrap();
+        let text = fs::read_to_string(p).unwrap();
+        let mut buf = vec![Case::default(); 1 << 16];
+        let n = vectors::load(&text, &mut buf)
+            .unwrap_or_else(|(line, e)| panic!("{}:{line}: {e:?}", p.display()));
+        let bin = out.join(format!("{name}.bin"));
+        fs::write(&bin, encode(&buf[..n])).unwrap();
         writeln!(
             src,
-            "    ({name:?}, include_str!({:?})),",
-            p.display().to_string()
+            "    ({name:?}, raylane_fw::Cases(include_bytes!({:?}))),",
+            bin.display().to_string()
         )
         .unwrap();
     }
     src.push_str("];\n");
     fs::write(out.join("files.rs"), src).unwrap();
+}
+
+/// Per case, little-endian: kind (u8: 0 sphere, 1 plane, 2 triangle), number of expected
+/// values (u8), line (u16), the kind's inputs (f32 bits), the expected values (f32 bits).
+fn encode(cases: &[Case]) -> Vec<u8> {
+    let mut b = Vec::new();
+    for c in cases {
+        let kind = match c.kind {
+            Kind::Sphere => 0u8,
+            Kind::Plane => 1,
+            Kind::Triangle => 2,
+        };
+        b.push(kind);
+        b.push(c.expect.n);
+        b.extend_from_slice(&u16::try_from(c.line).expect("line < 65536").to_le_bytes());
+        for x in &c.input[..c.kind.inputs()] {
+            b.extend_from_slice(&x.to_bits().to_le_bytes());
+        }
+        for x in c.expect.as_slice() {
+            b.extend_from_slice(&x.to_bits().to_le_bytes());
+        }
+    }
+    b
 }

@@ -44,7 +44,7 @@ use glam::Vec3;
 
 use crate::camera::Pinhole;
 use crate::hit::Hit;
-use crate::lane::{Lane, Mask, sqrt_f32};
+use crate::lane::{Lane, MAX_LANES, Mask, sqrt_f32};
 use crate::mesh::{FocalMesh, Mesh};
 use crate::plane::{self, FocalPlane, Plane};
 use crate::ray::RayPacket;
@@ -453,20 +453,20 @@ pub struct Frame<'a> {
 /// What is hit in each lane of a packet, merged over the kinds of primitive.
 #[derive(Clone, Copy, Debug)]
 struct Best {
-    t: [f32; 16],
-    id: [u8; 16],
+    t: [f32; MAX_LANES],
+    id: [u8; MAX_LANES],
     /// Sphere, plane or triangle index (within its part).
-    index: [u32; 16],
-    part: [u8; 16],
+    index: [u32; MAX_LANES],
+    part: [u8; MAX_LANES],
 }
 
 impl Best {
     fn new() -> Self {
         Best {
-            t: [f32::INFINITY; 16],
-            id: [ID_NONE; 16],
-            index: [0; 16],
-            part: [0; 16],
+            t: [f32::INFINITY; MAX_LANES],
+            id: [ID_NONE; MAX_LANES],
+            index: [0; MAX_LANES],
+            part: [0; MAX_LANES],
         }
     }
 
@@ -477,7 +477,7 @@ impl Best {
             let i = bits.trailing_zeros() as usize;
             bits &= bits - 1;
             let t = h.t.lane(i);
-            if i < 16 && t < self.t[i] {
+            if i < MAX_LANES && t < self.t[i] {
                 self.t[i] = t;
                 self.id[i] = id;
                 self.index[i] = h.index.as_ref().get(i).copied().unwrap_or(0);
@@ -489,13 +489,13 @@ impl Best {
     /// The rays with `t_max` relaxed to the closest hit so far (as the closest-hit loops do).
     fn shrink<L: Lane<Scalar = f32>>(&self, rays: &RayPacket<L>) -> RayPacket<L> {
         let mut hit = L::Mask::splat(false);
-        for i in 0..L::LANES.min(16) {
+        for i in 0..L::LANES.min(MAX_LANES) {
             if self.id[i] != ID_NONE {
                 hit = hit.with_lane(i, true);
             }
         }
         let t = L::from_f32_fn(|i| {
-            let t = self.t[i.min(15)];
+            let t = self.t[i.min(MAX_LANES - 1)];
             t + f32::from_bits(t.to_bits() & 0x7fff_ffff) * (1.0 / 2_097_152.0)
         });
         rays.shrink(hit, t)
@@ -627,7 +627,7 @@ impl<'a> Frame<'a> {
         let mut stats = Stats::default();
         let x_end = tile.x.saturating_add(tile.width).min(self.camera.width());
         let y_end = tile.y.saturating_add(tile.height).min(self.camera.height());
-        let lanes = L::LANES.min(16);
+        let lanes = L::LANES.min(MAX_LANES);
         for y in tile.y..y_end {
             let mut x = tile.x;
             while x < x_end {
@@ -664,6 +664,7 @@ impl<'a> Frame<'a> {
     /// its own out-of-line function: smaller functions, much quicker to compile for every lane
     /// width.)
     fn trace<L: Lane<Scalar = f32>>(&self, rays: &RayPacket<L>, stats: &mut Stats) -> Best {
+        crate::lane::assert_fits::<L>();
         let k = count(rays);
         stats.rays += k;
         let mut best = Best::new();
@@ -745,7 +746,8 @@ impl<'a> Frame<'a> {
         guarded: bool,
     ) -> Hit<L> {
         let mut best = Hit::<L>::none();
-        let mut entries = [empty_sphere(); 16];
+        crate::lane::assert_fits::<L>();
+        let mut entries = [empty_sphere(); MAX_LANES];
         for (j, s) in self.scene.spheres.iter().enumerate() {
             for (i, e) in entries.iter_mut().enumerate().take(L::LANES) {
                 let o = rays.origin().lane(i);
@@ -755,7 +757,7 @@ impl<'a> Frame<'a> {
                     FocalSphere::unguarded(o, s)
                 };
             }
-            let cache = FocalSphere::<L>::gather(&entries[..L::LANES.min(16)]);
+            let cache = FocalSphere::<L>::gather(&entries[..L::LANES.min(MAX_LANES)]);
             let h = K::roots(rays, &cache).first();
             let take = h.mask & h.t.lt(best.t);
             best.t = L::select(take, h.t, best.t);

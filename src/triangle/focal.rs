@@ -509,9 +509,10 @@ impl<L: Lane> FocalRays<L> {
         let (ax, ay, az) = (d.x.abs(), d.y.abs(), d.z.abs());
         let m = L::select(ax.ge(ay), ax, ay);
         let m = L::select(m.ge(az), m, az);
-        let mut s = [0f64; 16];
-        let mut lo = [0f32; 16];
-        let mut hi = [0f32; 16];
+        crate::lane::assert_fits::<L>();
+        let mut s = [0f64; crate::lane::MAX_LANES];
+        let mut lo = [0f32; crate::lane::MAX_LANES];
+        let mut hi = [0f32; crate::lane::MAX_LANES];
         for i in 0..L::LANES {
             let inv;
             (s[i], inv) = pow2_scale(m.lane(i).to_f64());

@@ -180,7 +180,8 @@ impl<L: Lane> TrianglePacket<L> {
     #[inline]
     #[must_use]
     pub fn from_fn(mut f: impl FnMut(usize) -> Triangle) -> Self {
-        let mut t = [Triangle::never(); 16];
+        crate::lane::assert_fits::<L>();
+        let mut t = [Triangle::never(); crate::lane::MAX_LANES];
         for (i, slot) in t.iter_mut().enumerate().take(L::LANES) {
             *slot = f(i);
         }

@@ -1,6 +1,12 @@
-//! Shared by the firmware binaries: a function that calls every kernel of raylane at one lane
-//! width (every formulation and entry point), with inputs from volatile reads and results to a
-//! volatile sink so nothing is folded away.
+//! Shared by the firmware binaries:
+//!
+//! * the platform: [`entry`], [`semihosting`] (printing, host files, exit codes) and [`exit`]
+//!   for Cortex-M (cortex-m-rt, cortex-m-semihosting) and RISC-V (riscv-rt,
+//!   riscv-semihosting), and [`panic_exits!`], a panic handler that prints and fails;
+//! * [`Cases`], the test vectors as `build.rs` encodes them;
+//! * [`every_kernel`], which calls every kernel of raylane at one lane width (every
+//!   formulation and entry point), with inputs from volatile reads and results to a volatile
+//!   sink so nothing is folded away.
 #![no_std]
 
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
@@ -15,7 +21,106 @@ use raylane::sphere::{
 use raylane::triangle::{
     self, Cramer, Cull, FocalRays, FocalTriangle, Moller, Triangle, TrianglePacket, Watertight,
 };
+use raylane::vectors::{Case, Kind, Values};
 use raylane::{Hit, Lane, Mask, Ray, RayPacket};
+
+// The critical-section implementations the semihosting crates need (single core / hart).
+#[cfg(target_arch = "arm")]
+use cortex_m as _;
+#[cfg(target_arch = "riscv32")]
+use riscv as _;
+
+/// The program's entry point (`#[entry] fn main() -> !`).
+#[cfg(target_arch = "arm")]
+pub use cortex_m_rt::entry;
+/// Semihosting: `hprintln!`, `syscall!`, `nr`, `debug`.
+#[cfg(target_arch = "arm")]
+pub use cortex_m_semihosting as semihosting;
+/// The program's entry point (`#[entry] fn main() -> !`).
+#[cfg(target_arch = "riscv32")]
+pub use riscv_rt::entry;
+/// Semihosting: `hprintln!`, `syscall!`, `nr`, `debug`.
+#[cfg(target_arch = "riscv32")]
+pub use riscv_semihosting as semihosting;
+
+/// Ends the QEMU run through semihosting: exit status 0 on `success`, else 1.
+pub fn exit(success: bool) -> ! {
+    use semihosting::debug;
+    debug::exit(if success {
+        debug::EXIT_SUCCESS
+    } else {
+        debug::EXIT_FAILURE
+    });
+    // Not reached: the semihosting exit ends the QEMU run.
+    loop {
+        core::hint::spin_loop();
+    }
+}
+
+/// Defines the panic handler: prints the panic through semihosting and exits with failure.
+#[macro_export]
+macro_rules! panic_exits {
+    () => {
+        #[panic_handler]
+        fn panic(info: &core::panic::PanicInfo) -> ! {
+            $crate::semihosting::hprintln!("{}", info);
+            $crate::exit(false)
+        }
+    };
+}
+
+/// One vector file's cases, encoded by `build.rs` (parsed there by raylane's own parser): per
+/// case, little-endian, the kind (u8: 0 sphere, 1 plane, 2 triangle), the number of expected
+/// values (u8), the line (u16), the kind's inputs and the expected values (f32 bits each).
+/// About a third of the text's size, and nothing to parse on the target.
+#[derive(Clone, Copy)]
+pub struct Cases(pub &'static [u8]);
+
+impl Cases {
+    /// Decodes the case at `*pos` and moves past it; `None` at the end or on a truncated or
+    /// malformed record (then `*pos` stays put, short of the end).
+    pub fn next(&self, pos: &mut usize) -> Option<Case> {
+        let b = self.0.get(*pos..)?;
+        let (&[kind, n, l0, l1], rest) = b.split_first_chunk::<4>()?;
+        let kind = match kind {
+            0 => Kind::Sphere,
+            1 => Kind::Plane,
+            2 => Kind::Triangle,
+            _ => return None,
+        };
+        let (inputs, n) = (kind.inputs(), n as usize);
+        if n > 3 || rest.len() < 4 * (inputs + n) {
+            return None;
+        }
+        let f = |i: usize| {
+            let mut w = [0u8; 4];
+            w.copy_from_slice(&rest[4 * i..4 * i + 4]);
+            f32::from_bits(u32::from_le_bytes(w))
+        };
+        let mut c = Case {
+            kind,
+            line: u16::from_le_bytes([l0, l1]) as u32,
+            expect: Values {
+                n: n as u8,
+                v: [0.0; 3],
+            },
+            ..Case::default()
+        };
+        for i in 0..inputs {
+            c.input[i] = f(i);
+        }
+        for k in 0..n {
+            c.expect.v[k] = f(inputs + k);
+        }
+        *pos += 4 + 4 * (inputs + n);
+        Some(c)
+    }
+
+    /// True when `pos` is exactly the end (every record decoded).
+    pub fn done(&self, pos: usize) -> bool {
+        pos == self.0.len()
+    }
+}
 
 static INPUT: [f32; 16] = [
     0.0, 1.0, 2.0, -1.0, 0.5, 5.0, 3.0, -10.0, 0.25, 4.0, 0.1, -0.3, 7.0, 1.5, -2.0, 0.75,

@@ -70,3 +70,31 @@ fn every_other_count_is_pinned() {
         assert_eq!(get(k, p), n, "{k}/{p}");
     }
 }
+
+#[test]
+fn a_panicking_measurement_releases_the_lock() {
+    use raylane::opcount::{Counted, measure};
+    use std::sync::mpsc;
+    use std::time::Duration;
+
+    let panicked = std::panic::catch_unwind(|| {
+        measure(|| {
+            let _ = Counted(1.0f32) + Counted(2.0);
+            panic!("a measured closure panics");
+        })
+    });
+    assert!(panicked.is_err());
+    // A later measurement (on another thread, so that a lock left taken fails the test
+    // instead of hanging it) gets the lock and counts.
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let ((), c) = measure(|| {
+            let _ = Counted(1.0f32) * Counted(2.0);
+        });
+        let _ = tx.send(c);
+    });
+    let c = rx
+        .recv_timeout(Duration::from_secs(60))
+        .expect("the lock was released by the panicking measurement");
+    assert_eq!(c.mul, 1);
+}

@@ -15,15 +15,16 @@
 
 use core::hint::black_box;
 
-use cortex_m_rt::entry;
-use cortex_m_semihosting::{debug, hprintln};
-use panic_semihosting as _;
 use raylane::plane::{self, FocalPlane, Plane};
 use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
 use raylane::sphere::{self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
 use raylane::triangle::focal as tf;
 use raylane::triangle::{self, Cramer, Cull, FocalTriangle, Moller, Triangle, Watertight};
 use raylane::{Hit, Mask, Ray, RayPacket};
+use raylane_fw::semihosting::hprintln;
+use raylane_fw::{entry, exit};
+
+raylane_fw::panic_exits!();
 
 #[path = "../../../benches/src/scene.rs"]
 #[allow(dead_code)]
@@ -42,7 +43,12 @@ const RAYS: usize = (SIDE * SIDE) as usize;
 #[unsafe(no_mangle)]
 pub extern "C" fn bench_begin() {
     // SAFETY: an assembler comment; no effect.
-    unsafe { core::arch::asm!("@ bench_begin", options(nomem, nostack, preserves_flags)) }
+    unsafe {
+        core::arch::asm!(
+            "/* bench_begin */",
+            options(nomem, nostack, preserves_flags)
+        )
+    }
 }
 
 /// End of a counted window (the plugin's `stop=` address).
@@ -50,7 +56,7 @@ pub extern "C" fn bench_begin() {
 #[unsafe(no_mangle)]
 pub extern "C" fn bench_end() {
     // SAFETY: an assembler comment; no effect.
-    unsafe { core::arch::asm!("@ bench_end", options(nomem, nostack, preserves_flags)) }
+    unsafe { core::arch::asm!("/* bench_end */", options(nomem, nostack, preserves_flags)) }
 }
 
 /// One frame of closest-hit queries, one ray at a time; returns the rays hit.
@@ -152,9 +158,5 @@ fn main() -> ! {
     hprintln!("scene coherent {:016x}", digest(&coherent, &s));
     measure(&s, miss, "miss");
     measure(&s, &coherent, "coherent");
-    debug::exit(debug::EXIT_SUCCESS);
-    // Not reached: the semihosting exit ends the QEMU run.
-    loop {
-        cortex_m::asm::wfi();
-    }
+    exit(true)
 }

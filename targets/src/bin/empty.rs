@@ -2,16 +2,11 @@
 #![no_std]
 #![no_main]
 
-use cortex_m_rt::entry;
-use cortex_m_semihosting::debug;
+use raylane_fw::{entry, exit};
 
 #[entry]
 fn main() -> ! {
-    debug::exit(debug::EXIT_SUCCESS);
-    // Not reached: the semihosting exit ends the QEMU run.
-    loop {
-        cortex_m::asm::wfi();
-    }
+    exit(true)
 }
 
 #[panic_handler]

@@ -11,11 +11,12 @@
 #![no_std]
 #![no_main]
 
-use cortex_m_rt::entry;
-use cortex_m_semihosting::{debug, hprintln, nr, syscall};
-use panic_semihosting as _;
 use raylane::demo::{self, Frame, Method, Storage, scenes::Mix};
 use raylane::triangle::FocalTriangle;
+use raylane_fw::semihosting::{hprintln, nr, syscall};
+use raylane_fw::{entry, exit};
+
+raylane_fw::panic_exits!();
 
 const W: u32 = Mix::FIRMWARE_SIZE.0;
 const H: u32 = Mix::FIRMWARE_SIZE.1;
@@ -51,10 +52,7 @@ fn write_file(path: &str, parts: &[&[u8]]) -> bool {
 }
 
 fn fail() -> ! {
-    debug::exit(debug::EXIT_FAILURE);
-    loop {
-        cortex_m::asm::wfi();
-    }
+    exit(false)
 }
 
 #[entry]
@@ -100,8 +98,5 @@ fn main() -> ! {
         PATH.trim_end_matches('\0'),
         n + rgb.len()
     );
-    debug::exit(debug::EXIT_SUCCESS);
-    loop {
-        cortex_m::asm::wfi();
-    }
+    exit(true)
 }
