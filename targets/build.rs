@@ -64,8 +64,9 @@ fn main() {
     fs::write(out.join("files.rs"), src).unwrap();
 }
 
-/// Per case, little-endian: kind (u8: 0 sphere, 1 plane, 2 triangle), number of expected
-/// values (u8), line (u16), the kind's inputs (f32 bits), the expected values (f32 bits).
+/// Per case, little-endian: kind (u8: 0 sphere, 1 plane, 2 triangle), the number of expected
+/// values (low nibble) and of their conditioning values (high nibble) (u8), line (u16), the
+/// kind's inputs, the expected values, their conditioning (f32 bits).
 fn encode(cases: &[Case]) -> Vec<u8> {
     let mut b = Vec::new();
     for c in cases {
@@ -75,12 +76,13 @@ fn encode(cases: &[Case]) -> Vec<u8> {
             Kind::Triangle => 2,
         };
         b.push(kind);
-        b.push(c.expect.n);
+        // The low nibble counts the expected values, the high nibble their conditioning.
+        b.push(c.expect.n | (c.cond.n << 4));
         b.extend_from_slice(&u16::try_from(c.line).expect("line < 65536").to_le_bytes());
         for x in &c.input[..c.kind.inputs()] {
             b.extend_from_slice(&x.to_bits().to_le_bytes());
         }
-        for x in c.expect.as_slice() {
+        for x in c.expect.as_slice().iter().chain(c.cond.as_slice()) {
             b.extend_from_slice(&x.to_bits().to_le_bytes());
         }
     }

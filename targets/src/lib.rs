@@ -88,8 +88,9 @@ impl Cases {
             2 => Kind::Triangle,
             _ => return None,
         };
-        let (inputs, n) = (kind.inputs(), n as usize);
-        if n > 3 || rest.len() < 4 * (inputs + n) {
+        // The low nibble counts the expected values, the high nibble their conditioning.
+        let (inputs, m, n) = (kind.inputs(), (n >> 4) as usize, (n & 15) as usize);
+        if n > 3 || m > 3 || rest.len() < 4 * (inputs + n + m) {
             return None;
         }
         let f = |i: usize| {
@@ -112,7 +113,11 @@ impl Cases {
         for k in 0..n {
             c.expect.v[k] = f(inputs + k);
         }
-        *pos += 4 + 4 * (inputs + n);
+        c.cond.n = m as u8;
+        for k in 0..m {
+            c.cond.v[k] = f(inputs + n + k);
+        }
+        *pos += 4 + 4 * (inputs + n + m);
         Some(c)
     }
 
