@@ -49,15 +49,29 @@
 //! assert_eq!(hits.lane(7).unwrap().t, 5.0);
 //! ```
 
+mod badouel;
+mod baldwin;
 mod cramer;
 pub(crate) mod exact;
 pub mod focal;
+mod havel;
+mod kensler;
 mod moller;
+mod plucker;
+mod precomputed;
+mod wald;
 mod watertight;
 
+pub use badouel::{Badouel, BadouelRecord};
+pub use baldwin::{AffineRecord, BaldwinWeber};
 pub use cramer::Cramer;
 pub use focal::{FocalRays, FocalTriangle};
+pub use havel::{HavelHerout, PlanesRecord};
+pub use kensler::KenslerShirley;
 pub use moller::Moller;
+pub use plucker::Plucker;
+pub use precomputed::PrecomputedKernel;
+pub use wald::{Wald, WaldRecord};
 pub use watertight::{Shear, Watertight};
 
 use glam::Vec3;

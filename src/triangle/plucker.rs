@@ -1,0 +1,102 @@
+//! Plücker-coordinate edge tests relative to the ray origin (Segura & Feito 1998; as in
+//! Embree's `triangle_intersector_pluecker.h`).
+
+use super::{Cull, TriangleKernel, TrianglePacket, resolve};
+use crate::hit::LaneHit;
+use crate::lane::{Lane, Mask};
+use crate::ray::RayPacket;
+
+/// Rafael J. Segura and Francisco R. Feito, "An Algorithm for Determining Intersection
+/// Segment-Polygon in 3D", Computers & Graphics 22(5), 1998, pp. 587–592 (the signs of
+/// tetrahedron volumes, i.e. Plücker side products), in the form Embree uses
+/// (`kernels/geometry/triangle_intersector_pluecker.h`): the vertices are shifted so that the
+/// ray starts at the origin, where the Plücker product of the ray with an edge `(p, q)`
+/// reduces to a triple product `d·(p × q)`, computed as `d·((q − p) × (q + p))/2`.
+///
+/// ```text
+/// v0 = A − o, v1 = B − o, v2 = C − o
+/// U = d·((v2 − v0) × (v2 + v0))    edge CA, opposite B (weight of B)
+/// V = d·((v0 − v1) × (v0 + v1))    edge AB, opposite C (weight of C)
+/// W = d·((v1 − v2) × (v1 + v2))    edge BC, opposite A
+/// den = d·N,  T = v0·N,  N = (v2 − v0) × (v0 − v1)  (= (B − A) × (C − A))
+/// ```
+///
+/// A hit needs `U`, `V`, `W` all `≥ 0` or all `≤ 0` (front faces: `≤ 0`; Embree widens both by
+/// `2^-23·|U+V+W|`, here they are exact compares), `den ≠ 0`, then `0 < T/den` inside the
+/// interval with the division deferred (see [`triangle`](super)); `u = U/(U+V+W)`,
+/// `v = V/(U+V+W)` as Embree normalises them. Embree scales `den` and `T` by 2 (`twice`),
+/// which cancels in `T/den` and is left out, and picks each component of `N` from the
+/// better-conditioned of two cross products (`stable_triangle_normal`, 6 mul, 3 add, 3 cmp
+/// more); here `N` is one cross product.
+///
+/// **Why the edges are consistent.** `v2 − v0` is exactly `−(v0 − v2)` and `v2 + v0` exactly
+/// `v0 + v2`, so a neighbour sharing the edge computes exactly the negated product: an edge
+/// test never leaks between two triangles that share it (the shifted vertices are the same
+/// bits for both), although a ray through a shared edge or vertex may hit both.
+///
+/// **Claimed count.** Embree documents none; measured here per lane: miss 27 mul, 44 add,
+/// 6 cmp; hit 33 mul, 48 add, 1 div, 12 cmp.
+///
+/// **Edge cases.** `den = 0` or `U + V + W = 0` is a miss; NaN fails every compare.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Plucker;
+
+impl TriangleKernel for Plucker {
+    const NAME: &'static str = "plucker";
+    type Rays<L: Lane> = ();
+
+    #[inline(always)]
+    fn prepare<L: Lane>(_: &RayPacket<L>) -> Self::Rays<L> {}
+
+    #[inline(always)]
+    fn intersect<L: Lane>(
+        ray: &RayPacket<L>,
+        _: &(),
+        tri: &TrianglePacket<L>,
+        cull: Cull,
+    ) -> LaneHit<L> {
+        let zero = L::from_f32(0.0);
+        let d = ray.dir;
+        // 1. Vertices relative to the origin, and the edges.
+        let v0 = tri.a - ray.origin;
+        let v1 = tri.b - ray.origin;
+        let v2 = tri.c - ray.origin;
+        let e0 = v2 - v0;
+        let e1 = v0 - v1;
+        let e2 = v1 - v2;
+        // 2. Edge tests: the side of the ray against each edge.
+        let u = d.dot(e0.cross(v2 + v0));
+        let v = d.dot(e1.cross(v0 + v1));
+        let w = d.dot(e2.cross(v1 + v2));
+        let front = u.le(zero) & v.le(zero) & w.le(zero);
+        let mut mask = if cull.back() {
+            front
+        } else {
+            front | (u.ge(zero) & v.ge(zero) & w.ge(zero))
+        };
+        if mask.none() {
+            return LaneHit::miss();
+        }
+        // 3. Normal, denominator, distance numerator; signs folded in (u, v by U + V + W).
+        let n = e0.cross(e1);
+        let den = n.dot(d);
+        let tn = v0.dot(n);
+        let sum = u + v + w;
+        let neg = sum.lt(zero);
+        let dneg = den.lt(zero);
+        let (us, vs, asum) = (
+            L::select(neg, -u, u),
+            L::select(neg, -v, v),
+            L::select(neg, -sum, sum),
+        );
+        let ad = L::select(dneg, -den, den);
+        mask = mask & ad.gt(zero) & asum.gt(zero);
+        if mask.none() {
+            return LaneHit::miss();
+        }
+        // 4. The interval, the one division; u, v are deferred over U + V + W.
+        let mut h = resolve(ray, mask, L::select(dneg, -tn, tn), us, vs, ad);
+        h.w = L::select(h.mask, asum, L::from_f32(1.0));
+        h
+    }
+}

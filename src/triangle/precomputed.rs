@@ -1,0 +1,78 @@
+//! Triangle tests that run on data computed once per triangle.
+
+use super::{Cull, TriangleKernel, TrianglePacket};
+use crate::hit::LaneHit;
+use crate::lane::Lane;
+use crate::ray::RayPacket;
+
+/// A ray–triangle method that reads a record computed once per triangle (a plane, a
+/// projection, an affine transform) instead of the three vertices.
+///
+/// [`precompute`](Self::precompute) is one generic body over [`Lane`], like the test itself:
+/// lane `i` of the record is the record of the triangle in lane `i`, the same bits at every
+/// width (a record computed from a splat packet is a splat), and under
+/// [`Counted`](crate::opcount::Counted) it measures the precomputation's own operation count.
+/// Every implementor is also a [`TriangleKernel`] that precomputes on the fly, so the entry
+/// points, the checker and the tests run it unchanged; store records from
+/// [`precompute`](Self::precompute) to pay the precomputation once.
+///
+/// ```
+/// use glam::Vec3;
+/// use raylane::triangle::{Cull, PrecomputedKernel, Triangle, TrianglePacket, Wald};
+/// use raylane::RayPacket;
+///
+/// let tri = Triangle::new(Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0));
+/// let rec = Wald::precompute(&TrianglePacket::<f32>::splat(&tri)); // once per triangle
+/// let ray = raylane::Ray::new(Vec3::new(1.0, 1.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
+/// let hit = Wald::test(&RayPacket::<f32>::splat(&ray), &rec, Cull::None).normalized();
+/// assert_eq!((hit.t, hit.u, hit.v), (5.0, 0.25, 1.0 / 3.0));
+/// ```
+pub trait PrecomputedKernel {
+    /// The method's name (as the checker spells it; also its [`TriangleKernel::NAME`]).
+    const NAME: &'static str;
+    /// Bytes of the record per triangle, as the method stores it in memory.
+    const BYTES: usize;
+    /// The record, one triangle per lane.
+    type Prim<L: Lane>: Copy;
+    /// The records of the triangles in `tri`'s lanes.
+    fn precompute<L: Lane>(tri: &TrianglePacket<L>) -> Self::Prim<L>;
+    /// The hit of each ray lane on the record in the same lane (as
+    /// [`TriangleKernel::intersect`]: `u`, `v` may be deferred, see [`LaneHit::normalized`]).
+    fn test<L: Lane>(ray: &RayPacket<L>, pre: &Self::Prim<L>, cull: Cull) -> LaneHit<L>;
+}
+
+impl<K: PrecomputedKernel> TriangleKernel for K {
+    const NAME: &'static str = <K as PrecomputedKernel>::NAME;
+    type Rays<L: Lane> = ();
+
+    #[inline(always)]
+    fn prepare<L: Lane>(_: &RayPacket<L>) -> Self::Rays<L> {}
+
+    #[inline(always)]
+    fn intersect<L: Lane>(
+        ray: &RayPacket<L>,
+        _: &(),
+        tri: &TrianglePacket<L>,
+        cull: Cull,
+    ) -> LaneHit<L> {
+        K::test(ray, &K::precompute(tri), cull)
+    }
+}
+
+/// The axis of the largest `|n|` component, as masks ("is x", "is y"; z otherwise), x before
+/// y before z on ties: 3 cmp.
+#[inline(always)]
+pub(crate) fn dominant<L: Lane>(n: crate::vec3::V3<L>) -> (L::Mask, L::Mask) {
+    let (ax, ay, az) = (n.x.abs(), n.y.abs(), n.z.abs());
+    let is_x = ax.ge(ay) & ax.ge(az);
+    let is_y = !is_x & ay.ge(az);
+    (is_x, is_y)
+}
+
+/// `(v[k], v[k+1], v[k+2])` (indices mod 3) per lane, for `k` given as masks: the projection
+/// axis first, then the two axes of the projection plane in cyclic order (no arithmetic).
+#[inline(always)]
+pub(crate) fn cyclic<L: Lane>(k: (L::Mask, L::Mask), v: crate::vec3::V3<L>) -> crate::vec3::V3<L> {
+    let s = |x: L, y: L, z: L| L::select(k.0, x, L::select(k.1, y, z));
+    crate::vec3::V3::new(s(v.x, v.y, v.z), s(v.y, v.z, v.x), s(v.z, v.x, v.y))
+}
