@@ -33,8 +33,8 @@ use crate::plane::{self, FocalPlane, Plane, PlanePacket};
 use crate::ray::RayPacket;
 use crate::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
 use crate::sphere::{
-    FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Roots, Sphere, SphereKernel,
-    SpherePacket,
+    EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust, Roots, Sphere,
+    SphereKernel, SpherePacket,
 };
 use crate::triangle::{
     self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout,
@@ -328,6 +328,10 @@ pub enum Method {
     Moller,
     /// [`Watertight`]: triangles (Woop, Benthin, Wald 2013).
     Watertight,
+    /// [`Pbrt`]: spheres (pbrt-v4's sphere test, without intervals).
+    Pbrt,
+    /// [`EmbreeSphere`]: spheres (Embree's sphere test).
+    EmbreeSphere,
     /// [`Badouel`]: triangles (Badouel 1990: plane, then a 2-D test (precomputed plane)).
     Badouel,
     /// [`Plucker`]: triangles (Plücker edge tests relative to the origin (Segura–Feito 1998, as in Embree)).
@@ -344,7 +348,7 @@ pub enum Method {
 
 impl Method {
     /// Every method, in report order.
-    pub const ALL: [Method; 16] = [
+    pub const ALL: [Method; 18] = [
         Method::Quadratic,
         Method::QuadraticUnit,
         Method::Geometric,
@@ -355,6 +359,8 @@ impl Method {
         Method::Cramer,
         Method::Moller,
         Method::Watertight,
+        Method::Pbrt,
+        Method::EmbreeSphere,
         Method::Badouel,
         Method::Plucker,
         Method::Wald,
@@ -377,6 +383,8 @@ impl Method {
             Method::Cramer => Cramer::NAME,
             Method::Moller => Moller::NAME,
             Method::Watertight => Watertight::NAME,
+            Method::Pbrt => Pbrt::NAME,
+            Method::EmbreeSphere => EmbreeSphere::NAME,
             Method::Badouel => Badouel::NAME,
             Method::Plucker => Plucker::NAME,
             Method::Wald => Wald::NAME,
@@ -634,7 +642,7 @@ mod limits {
                 }
                 Limit::Inside
             }
-            Method::Robust => {
+            Method::Robust | Method::Pbrt | Method::EmbreeSphere => {
                 // |l| carries an error of about 8·2^-24·|f|; c = f·f − r² about 4·2^-24·|f|².
                 let el = 8.0 * U * c;
                 let l = sqrt(l2);
@@ -726,6 +734,8 @@ fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outco
                 Method::QuadraticUnit => QuadraticUnit::roots(&ray, &spheres()),
                 Method::Geometric => Geometric::roots(&ray, &spheres()),
                 Method::Robust => Robust::roots(&ray, &spheres()),
+                Method::Pbrt => Pbrt::roots(&ray, &spheres()),
+                Method::EmbreeSphere => EmbreeSphere::roots(&ray, &spheres()),
                 Method::Focal | Method::FocalUnguarded => {
                     let mut e =
                         [FocalSphere::<f32>::new(Vec3::ZERO, &Sphere::new(Vec3::ZERO, f32::NAN));
