@@ -21,8 +21,9 @@ use crate::ray::RayPacket;
 /// length is a square root, so the discriminant factors as `(r + ℓ)(r − ℓ)` instead of
 /// `r² − ℓ·ℓ`, and the factors 2, 4 and ½ of the textbook quadratic stay (exact multiplies).
 ///
-/// **Operation count per lane** (measured by `examples/opcount.rs`, the study table): miss
-/// 13 mul, 13 add, 1 div, 1 sqrt, 1 cmp; hit 14 mul, 14 add, 3 div, 2 sqrt, 7 cmp.
+/// **Operation count per lane** (measured by `examples/opcount.rs`, the study table; pinned in
+/// `tests/suite/opcount.rs`): miss 21 mul, 17 add, 1 div, 1 sqrt, 1 cmp; hit 22 mul, 18 add,
+/// 3 div, 2 sqrt, 7 cmp.
 ///
 /// **Limits.** The decisions carry the rounding of `ℓ` (a few `2^-24·|f|`), like
 /// [`Robust`](super::Robust)'s. **Edge cases.** `b = 0` with `Δ = 0` makes `q = 0`: roots NaN or

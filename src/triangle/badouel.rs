@@ -1,6 +1,6 @@
 //! Badouel's ray–polygon test for triangles: the plane, then a 2-D test in a projection.
 
-use super::precomputed::{PrecomputedKernel, cyclic, dominant};
+use super::precomputed::{PrecomputedKernel, cyclic, dominant, precomputed_triangle_kernel};
 use super::{Cull, TrianglePacket};
 use crate::hit::LaneHit;
 use crate::lane::{Lane, Mask};
@@ -27,9 +27,9 @@ use crate::vec3::V3;
 /// branch-free 2-D Cramer form instead (one multiply more, no branch).
 ///
 /// **Claimed count.** The Gem gives no operation tally (it compares timings); measured here
-/// per lane: miss 6 mul, 5 add, 1 div, 2 cmp when the plane rejects (behind the origin);
-/// beyond edge BC 10 mul, 14 add, 3 div, 5 cmp; hit 12 mul, 16 add, 3 div, 7 cmp;
-/// precomputation 9 mul, 11 add, 3 cmp. **Record:** 42 bytes (the plane, 16; the two axes,
+/// per lane (pinned in `tests/suite/opcount.rs`): a triangle behind the origin (the plane
+/// rejects) 6 mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit 14 mul, 17 add, 3 div,
+/// 6 cmp; precomputation 9 mul, 11 add, 3 cmp. **Record:** 42 bytes (the plane, 16; the two axes,
 /// 2 bytes as the Gem's `i1`, `i2`; six projected coordinates, 24).
 ///
 /// **Limits.** Not watertight (the edges are tested in each triangle's own projection, after
@@ -49,8 +49,9 @@ pub struct BadouelRecord<L: Lane> {
     c: [L; 2],
 }
 
+precomputed_triangle_kernel!(Badouel, "badouel");
+
 impl PrecomputedKernel for Badouel {
-    const NAME: &'static str = "badouel";
     const BYTES: usize = 42;
     type Prim<L: Lane> = BadouelRecord<L>;
 

@@ -1,6 +1,6 @@
 //! Baldwin and Weber's test: an affine transform to the unit triangle, precomputed (2016).
 
-use super::precomputed::{PrecomputedKernel, cyclic, dominant};
+use super::precomputed::{PrecomputedKernel, cyclic, dominant, precomputed_triangle_kernel};
 use super::{Cull, TrianglePacket};
 use crate::hit::LaneHit;
 use crate::lane::{Lane, Mask};
@@ -35,9 +35,9 @@ use crate::vec3::V3;
 /// A hit needs `t_min < t < t_max`, then `u ≥ 0`, `v ≥ 0`, `u + v ≤ 1`.
 ///
 /// **Claimed count.** The paper compares its running times with Möller–Trumbore's rather than
-/// counting operations; measured here per lane: a miss by the distance 6 mul, 5 add, 1 div,
-/// 2 cmp; beyond edge BC and hit 15 mul, 15 add, 1 div, 5 cmp; precomputation
-/// 24 mul, 14 add, 1 div, 3 cmp. **Record:** 48 bytes.
+/// counting operations; measured here per lane (pinned in `tests/suite/opcount.rs`): a
+/// triangle behind the origin 6 mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit
+/// 15 mul, 15 add, 1 div, 5 cmp; precomputation 22 mul, 15 add, 1 div, 3 cmp. **Record:** 48 bytes.
 ///
 /// **Limits.** Not watertight; `M` is rounded once per triangle, so `t`, `u`, `v` carry its
 /// rounding. **Edge cases.** A ray parallel to the plane (`e = 0`) gives an infinite or NaN
@@ -59,8 +59,9 @@ fn uncyclic<L: Lane>(k: (L::Mask, L::Mask), v: V3<L>) -> V3<L> {
     V3::new(s(v.x, v.z, v.y), s(v.y, v.x, v.z), s(v.z, v.y, v.x))
 }
 
+precomputed_triangle_kernel!(BaldwinWeber, "baldwin-weber");
+
 impl PrecomputedKernel for BaldwinWeber {
-    const NAME: &'static str = "baldwin-weber";
     const BYTES: usize = 48;
     type Prim<L: Lane> = AffineRecord<L>;
 

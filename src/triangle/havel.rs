@@ -1,6 +1,6 @@
 //! Havel and Herout's test on three precomputed planes (2010).
 
-use super::precomputed::PrecomputedKernel;
+use super::precomputed::{PrecomputedKernel, precomputed_triangle_kernel};
 use super::{Cull, TrianglePacket, resolve};
 use crate::hit::LaneHit;
 use crate::lane::{Lane, Mask};
@@ -27,8 +27,9 @@ use crate::vec3::V3;
 /// one division (see [`triangle`](super) on deferred division). Front faces have `det < 0`.
 ///
 /// **Claimed count.** The paper counts SSE4 instructions, not operations; measured here per
-/// lane: miss 20 mul, 19 add, 5 cmp; hit the same plus 1 mul, 1 div, 5 cmp;
-/// precomputation 30 mul, 19 add, 1 div. **Record:** 48 bytes.
+/// lane (pinned in `tests/suite/opcount.rs`): miss 20 mul, 16 add, 5 cmp; hit 21 mul, 16 add,
+/// 1 div, 10 cmp; behind the origin 20 mul, 16 add, 7 cmp; precomputation 36 mul, 23 add,
+/// 1 div. **Record:** 48 bytes.
 ///
 /// **Limits.** Not watertight; the scaled planes are rounded once per triangle, and `U`, `V`
 /// grow with the distance of the origin from the triangle (`P'` is formed before anything is
@@ -47,8 +48,9 @@ pub struct PlanesRecord<L: Lane> {
     d2: L,
 }
 
+precomputed_triangle_kernel!(HavelHerout, "havel-herout");
+
 impl PrecomputedKernel for HavelHerout {
-    const NAME: &'static str = "havel-herout";
     const BYTES: usize = 48;
     type Prim<L: Lane> = PlanesRecord<L>;
 

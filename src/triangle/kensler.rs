@@ -21,8 +21,9 @@ use crate::ray::RayPacket;
 /// faces have `n·d < 0`.
 ///
 /// **Claimed count.** The paper scores its candidates by counted operations and by timings;
-/// its tallies use its own weights, so only the measured counts are given: miss 22 mul,
-/// 17 add, 1 div, 3 cmp; hit 26 mul, 19 add, 1 div, 5 cmp.
+/// its tallies use its own weights, so only the measured counts are given (pinned in
+/// `tests/suite/opcount.rs`): miss 23 mul, 22 add, 1 div, 3 cmp; hit 27 mul, 24 add, 1 div,
+/// 5 cmp.
 ///
 /// **Limits.** Not watertight (`c` differs between triangles that share an edge), and the
 /// reciprocal rounds once more than a division. **Edge cases.** `n·d = 0` makes `k` infinite and

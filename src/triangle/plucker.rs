@@ -24,7 +24,8 @@ use crate::ray::RayPacket;
 /// A hit needs `U`, `V`, `W` all `≥ −ε` or all `≤ ε` with `ε = 2^-23·|U + V + W|`, as Embree
 /// widens them (front faces: `≤ ε`), `den ≠ 0`, then `0 < T/den` inside the
 /// interval with the division deferred (see [`triangle`](super)); `u = U/(U+V+W)`,
-/// `v = V/(U+V+W)` as Embree normalises them. Embree scales `den` and `T` by 2 (`twice`),
+/// `v = V/(U+V+W)` as Embree normalises them, after clamping the three at zero (Embree does not
+/// clamp; here the reported `u`, `v` keep `u, v ≥ 0`, `u + v ≤ 1`). Embree scales `den` and `T` by 2 (`twice`),
 /// which cancels in `T/den` and is left out, and picks each component of `N` from the
 /// better-conditioned of two cross products (`stable_triangle_normal`, 6 mul, 3 add, 3 cmp
 /// more); here `N` is one cross product.
@@ -37,8 +38,8 @@ use crate::ray::RayPacket;
 /// without the widening `ε` they can all exclude the ray: exact compares leaked 4 of the
 /// 10,950 rays of `tests/suite/watertight.rs`; with `ε` the counts are in the study table.
 ///
-/// **Claimed count.** Embree documents none; measured here per lane: miss 27 mul, 44 add,
-/// 6 cmp; hit 33 mul, 48 add, 1 div, 12 cmp.
+/// **Claimed count.** Embree documents none; measured here per lane (pinned in
+/// `tests/suite/opcount.rs`): miss 28 mul, 44 add, 6 cmp; hit 41 mul, 53 add, 1 div, 18 cmp.
 ///
 /// **Edge cases.** `den = 0` or `U + V + W = 0` is a miss; NaN fails every compare.
 #[derive(Clone, Copy, Debug, Default)]
@@ -85,17 +86,20 @@ impl TriangleKernel for Plucker {
         if mask.none() {
             return LaneHit::miss();
         }
-        // 3. Normal, denominator, distance numerator; signs folded in (u, v by U + V + W).
+        // 3. Normal, denominator, distance numerator. The edge values get the sign of
+        //    U + V + W folded in and are clamped at zero (the widening lets them reach −ε), so
+        //    that u, v ≥ 0 and u + v ≤ 1 hold for the reported hit.
         let n = e0.cross(e1);
         let den = n.dot(d);
         let tn = v0.dot(n);
         let neg = sum.lt(zero);
         let dneg = den.lt(zero);
-        let (us, vs, asum) = (
-            L::select(neg, -u, u),
-            L::select(neg, -v, v),
-            L::select(neg, -sum, sum),
-        );
+        let fold = |x: L| {
+            let x = L::select(neg, -x, x);
+            L::select(x.lt(zero), zero, x)
+        };
+        let (us, vs, ws) = (fold(u), fold(v), fold(w));
+        let asum = us + vs + ws;
         let ad = L::select(dneg, -den, den);
         mask = mask & ad.gt(zero) & asum.gt(zero);
         if mask.none() {

@@ -1,6 +1,6 @@
 //! Triangle tests that run on data computed once per triangle.
 
-use super::{Cull, TriangleKernel, TrianglePacket};
+use super::{Cull, TrianglePacket};
 use crate::hit::LaneHit;
 use crate::lane::Lane;
 use crate::ray::RayPacket;
@@ -12,7 +12,7 @@ use crate::ray::RayPacket;
 /// lane `i` of the record is the record of the triangle in lane `i`, the same bits at every
 /// width (a record computed from a splat packet is a splat), and under
 /// [`Counted`](crate::opcount::Counted) it measures the precomputation's own operation count.
-/// Every implementor is also a [`TriangleKernel`] that precomputes on the fly, so the entry
+/// Every implementor is also a [`TriangleKernel`](super::TriangleKernel) that precomputes on the fly, so the entry
 /// points, the checker and the tests run it unchanged; store records from
 /// [`precompute`](Self::precompute) to pay the precomputation once.
 ///
@@ -28,8 +28,6 @@ use crate::ray::RayPacket;
 /// assert_eq!((hit.t, hit.u, hit.v), (5.0, 0.25, 1.0 / 3.0));
 /// ```
 pub trait PrecomputedKernel {
-    /// The method's name (as the checker spells it; also its [`TriangleKernel::NAME`]).
-    const NAME: &'static str;
     /// Bytes of the record per triangle, as the method stores it in memory.
     const BYTES: usize;
     /// The record, one triangle per lane.
@@ -37,27 +35,35 @@ pub trait PrecomputedKernel {
     /// The records of the triangles in `tri`'s lanes.
     fn precompute<L: Lane>(tri: &TrianglePacket<L>) -> Self::Prim<L>;
     /// The hit of each ray lane on the record in the same lane (as
-    /// [`TriangleKernel::intersect`]: `u`, `v` may be deferred, see [`LaneHit::normalized`]).
+    /// [`TriangleKernel::intersect`](super::TriangleKernel::intersect): `u`, `v` may be deferred, see [`LaneHit::normalized`]).
     fn test<L: Lane>(ray: &RayPacket<L>, pre: &Self::Prim<L>, cull: Cull) -> LaneHit<L>;
 }
 
-impl<K: PrecomputedKernel> TriangleKernel for K {
-    const NAME: &'static str = <K as PrecomputedKernel>::NAME;
-    type Rays<L: Lane> = ();
+/// Implements [`TriangleKernel`] for a [`PrecomputedKernel`] by precomputing on the fly, with
+/// the checker's name.
+macro_rules! precomputed_triangle_kernel {
+    ($k:ty, $name:literal) => {
+        impl $crate::triangle::TriangleKernel for $k {
+            const NAME: &'static str = $name;
+            type Rays<L: $crate::lane::Lane> = ();
 
-    #[inline(always)]
-    fn prepare<L: Lane>(_: &RayPacket<L>) -> Self::Rays<L> {}
+            #[inline(always)]
+            fn prepare<L: $crate::lane::Lane>(_: &$crate::ray::RayPacket<L>) -> Self::Rays<L> {}
 
-    #[inline(always)]
-    fn intersect<L: Lane>(
-        ray: &RayPacket<L>,
-        _: &(),
-        tri: &TrianglePacket<L>,
-        cull: Cull,
-    ) -> LaneHit<L> {
-        K::test(ray, &K::precompute(tri), cull)
-    }
+            #[inline(always)]
+            fn intersect<L: $crate::lane::Lane>(
+                ray: &$crate::ray::RayPacket<L>,
+                _: &(),
+                tri: &$crate::triangle::TrianglePacket<L>,
+                cull: $crate::triangle::Cull,
+            ) -> $crate::hit::LaneHit<L> {
+                use $crate::triangle::PrecomputedKernel as _;
+                <$k>::test(ray, &<$k>::precompute(tri), cull)
+            }
+        }
+    };
 }
+pub(crate) use precomputed_triangle_kernel;
 
 /// The axis of the largest `|n|` component, as masks ("is x", "is y"; z otherwise), x before
 /// y before z on ties: 3 cmp.

@@ -1,6 +1,6 @@
 //! Wald's projection test with a precomputed record (his thesis, 2004).
 
-use super::precomputed::{PrecomputedKernel, cyclic, dominant};
+use super::precomputed::{PrecomputedKernel, cyclic, dominant, precomputed_triangle_kernel};
 use super::{Cull, TrianglePacket};
 use crate::hit::LaneHit;
 use crate::lane::{Lane, Mask};
@@ -26,10 +26,10 @@ use crate::ray::RayPacket;
 /// multiply, as in the thesis.
 ///
 /// **Claimed count.** The thesis presents the test as the cheapest of its time without an
-/// operation tally comparable to this one; measured here per lane: a miss by the distance 5 mul,
-/// 5 add, 1 div, 2 cmp; beyond edge BC 9 mul, 10 add, 1 div, 4 cmp (`u` alone fails earlier:
-/// 9 mul, 9 add, 3 cmp); hit 11 mul, 12 add, 1 div, 5 cmp; precomputation 17 mul, 14 add,
-/// 1 div, 3 cmp. **Record:** 37 bytes (nine floats and the axis with the sign of `N_k` in
+/// operation tally comparable to this one; measured here per lane (pinned in
+/// `tests/suite/opcount.rs`): a triangle behind the origin 5 mul, 5 add, 1 div, 2 cmp; a miss
+/// beyond edge BC and a hit 11 mul, 12 add, 1 div, 5 cmp; precomputation 20 mul, 13 add,
+/// 1 div, 4 cmp. **Record:** 37 bytes (nine floats and the axis with the sign of `N_k` in
 /// one byte; the thesis pads its `TriAccel` to 48).
 ///
 /// **Limits.** Not watertight; the scaled plane and lines are rounded once per triangle, so
@@ -48,8 +48,9 @@ pub struct WaldRecord<L: Lane> {
     neg: L::Mask,
 }
 
+precomputed_triangle_kernel!(Wald, "wald");
+
 impl PrecomputedKernel for Wald {
-    const NAME: &'static str = "wald";
     const BYTES: usize = 37;
     type Prim<L: Lane> = WaldRecord<L>;
 
