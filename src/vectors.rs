@@ -517,7 +517,8 @@ mod limits {
                 // t is a triple product over the determinant, each rounded at the scale of
                 // |e1|·|e2|·|s|: on needles the relative error of t grows with the aspect
                 // ratio while t itself stays well conditioned. Measured (triangle_needle.txt):
-                // at most 1.92·2^-24·aspect.
+                // at most 1.92·2^-24·aspect (Cramer, Möller; Plücker and Kensler–Shirley form
+                // t the same way and pass every case inside this bound).
                 if 2.0 * U * aspect > tol_t {
                     return Limit::Outside("needle: t error up to 2·2^-24·aspect ratio");
                 }

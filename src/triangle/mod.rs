@@ -76,7 +76,7 @@ pub use havel::{HavelHerout, PlanesRecord};
 pub use kensler::KenslerShirley;
 pub use moller::Moller;
 pub use plucker::Plucker;
-pub use precomputed::PrecomputedKernel;
+pub use precomputed::{PrecomputedKernel, closest_precomputed, precompute_all};
 pub use wald::{Wald, WaldRecord};
 pub use watertight::{Shear, Watertight};
 

@@ -1,6 +1,7 @@
 //! Triangle tests that run on data computed once per triangle.
 
-use super::{Cull, TrianglePacket};
+use super::{Cull, Triangle, TrianglePacket};
+use crate::hit::Hit;
 use crate::hit::LaneHit;
 use crate::lane::Lane;
 use crate::ray::RayPacket;
@@ -13,8 +14,8 @@ use crate::ray::RayPacket;
 /// width (a record computed from a splat packet is a splat), and under
 /// [`Counted`](crate::opcount::Counted) it measures the precomputation's own operation count.
 /// Every implementor is also a [`TriangleKernel`](super::TriangleKernel) that precomputes on the fly, so the entry
-/// points, the checker and the tests run it unchanged; store records from
-/// [`precompute`](Self::precompute) to pay the precomputation once.
+/// points, the checker and the tests run it unchanged; store records with [`precompute_all`]
+/// and query them with [`closest_precomputed`] to pay the precomputation once.
 ///
 /// ```
 /// use glam::Vec3;
@@ -81,4 +82,32 @@ pub(crate) fn dominant<L: Lane>(n: crate::vec3::V3<L>) -> (L::Mask, L::Mask) {
 pub(crate) fn cyclic<L: Lane>(k: (L::Mask, L::Mask), v: crate::vec3::V3<L>) -> crate::vec3::V3<L> {
     let s = |x: L, y: L, z: L| L::select(k.0, x, L::select(k.1, y, z));
     crate::vec3::V3::new(s(v.x, v.y, v.z), s(v.y, v.z, v.x), s(v.z, v.x, v.y))
+}
+
+/// Records of `tris` into `out`, one per triangle, each in every lane (from
+/// [`TrianglePacket::splat`]); returns the number written (at most `out.len()`). Build them
+/// once; [`closest_precomputed`] reads them.
+pub fn precompute_all<K: PrecomputedKernel, L: Lane>(
+    tris: &[Triangle],
+    out: &mut [K::Prim<L>],
+) -> usize {
+    let mut n = 0;
+    for (t, slot) in tris.iter().zip(out.iter_mut()) {
+        *slot = K::precompute(&TrianglePacket::splat(t));
+        n += 1;
+    }
+    n
+}
+
+/// Closest hit of ray lanes over stored records (N rays × 1 triangle, records from
+/// [`precompute_all`]): the same hits, bit for bit, as [`closest`](super::closest) with `K`,
+/// without precomputing per query. The index is the record's position.
+#[inline]
+#[must_use]
+pub fn closest_precomputed<K: PrecomputedKernel, L: Lane>(
+    rays: &RayPacket<L>,
+    records: &[K::Prim<L>],
+    cull: Cull,
+) -> Hit<L> {
+    crate::hit::closest(rays, records, |r, p| Some(K::test(r, p, cull)))
 }

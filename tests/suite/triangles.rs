@@ -15,7 +15,8 @@ use raylane::opcount::{OpCounts, table};
 use raylane::triangle::focal as tf;
 use raylane::triangle::{
     self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout,
-    KenslerShirley, Moller, Plucker, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
+    KenslerShirley, Moller, Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket,
+    Wald, Watertight,
 };
 use raylane::{Hit, LaneHit, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
@@ -312,6 +313,30 @@ fn entry_points_of<K: TriangleKernel, L: Lane<Scalar = f32>>(
     }
 }
 
+/// Stored records give the hits of the kernel that precomputes per query, bit for bit.
+fn stored_records<K, L>(rays: &[Ray], tris: &[Triangle], cull: Cull)
+where
+    K: PrecomputedKernel + TriangleKernel,
+    L: Lane<Scalar = f32>,
+{
+    let rp = RayPacket::<L>::from_rays(rays);
+    let mut records = vec![K::precompute(&TrianglePacket::<L>::splat(&tris[0])); tris.len()];
+    assert_eq!(
+        triangle::precompute_all::<K, L>(tris, &mut records),
+        tris.len()
+    );
+    let stored = triangle::closest_precomputed::<K, L>(&rp, &records, cull);
+    let fresh = triangle::closest::<K, L>(&rp, tris, cull);
+    for i in 0..rays.len() {
+        assert_eq!(
+            stored.lane(i),
+            fresh.lane(i),
+            "{} stored, lane {i}",
+            <K as TriangleKernel>::NAME
+        );
+    }
+}
+
 fn focal_entry_points<L: Lane<Scalar = f32>>(
     eye: Vec3,
     rays: &[Ray],
@@ -401,6 +426,10 @@ fn entry_points<L: Lane<Scalar = f32>>(seed: u64) {
             entry_points_of::<Watertight, L>(&rays, &tris, &mesh, cull);
             entry_points_of::<Plucker, L>(&rays, &tris, &mesh, cull);
             entry_points_of::<Wald, L>(&rays, &tris, &mesh, cull);
+            stored_records::<Wald, L>(&rays, &tris, cull);
+            stored_records::<Badouel, L>(&rays, &tris, cull);
+            stored_records::<HavelHerout, L>(&rays, &tris, cull);
+            stored_records::<BaldwinWeber, L>(&rays, &tris, cull);
             entry_points_of::<Moller, L>(&rays[..1], &tris[..1], &mesh, cull);
             // Rays from one eye for the focal caches.
             let eye = Vec3::new(
