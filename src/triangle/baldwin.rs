@@ -34,8 +34,8 @@ use crate::vec3::V3;
 ///
 /// A hit needs `t_min < t < t_max`, then `u ≥ 0`, `v ≥ 0`, `u + v ≤ 1`.
 ///
-/// **Claimed count.** The paper compares its running times with Möller–Trumbore's rather than
-/// counting operations; measured here per lane (pinned in `tests/suite/opcount.rs`): a
+/// **Claimed count.** not quoted: the paper's text was not available to this study (only its
+/// formulation, from secondary sources), so its own tally, if any, is not checked here. **Measured** per lane (pinned in `tests/suite/opcount.rs`): a
 /// triangle behind the origin 6 mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit
 /// 15 mul, 15 add, 1 div, 5 cmp; precomputation 22 mul, 15 add, 1 div, 3 cmp. **Record:** 48 bytes.
 ///

@@ -26,7 +26,8 @@ use crate::vec3::V3;
 /// sign of `det` is folded in and the three tested `≥ 0`), `det ≠ 0`, then the interval and the
 /// one division (see [`triangle`](super) on deferred division). Front faces have `det < 0`.
 ///
-/// **Claimed count.** The paper counts SSE4 instructions, not operations; measured here per
+/// **Claimed count.** not quoted: the paper's text was not available to this study (only its
+/// formulation, from secondary sources), so its own tally, if any, is not checked here. **Measured** per
 /// lane (pinned in `tests/suite/opcount.rs`): miss 20 mul, 16 add, 5 cmp; hit 21 mul, 16 add,
 /// 1 div, 10 cmp; behind the origin 20 mul, 16 add, 7 cmp; precomputation 36 mul, 23 add,
 /// 1 div. **Record:** 48 bytes.

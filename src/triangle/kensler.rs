@@ -20,8 +20,8 @@ use crate::ray::RayPacket;
 /// A hit needs `u ≥ 0`, `v ≥ 0`, `u + v ≤ 1` (tested first), then `t_min < t < t_max`. Front
 /// faces have `n·d < 0`.
 ///
-/// **Claimed count.** The paper scores its candidates by counted operations and by timings;
-/// its tallies use its own weights, so only the measured counts are given (pinned in
+/// **Claimed count.** not quoted: the paper's text was not available to this study (only its
+/// formulation, from secondary sources), so its own tally, if any, is not checked here. **Measured** per lane (pinned in
 /// `tests/suite/opcount.rs`): miss 23 mul, 22 add, 1 div, 3 cmp; hit 27 mul, 24 add, 1 div,
 /// 5 cmp.
 ///
