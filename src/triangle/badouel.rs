@@ -27,11 +27,11 @@ use crate::vec3::V3;
 /// branch-free 2-D Cramer form instead (one multiply more, no branch).
 ///
 /// **Claimed count.** not quoted: the paper's text was not available to this study (only its
-/// formulation, from secondary sources), so its own tally, if any, is not checked here. **Measured**
-/// per lane (pinned in `tests/suite/opcount.rs`): a triangle behind the origin (the plane
-/// rejects) 6 mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit 14 mul, 17 add, 3 div,
-/// 6 cmp; precomputation 9 mul, 11 add, 3 cmp. **Record:** 42 bytes (the plane, 16; the two axes,
-/// 2 bytes as the Gem's `i1`, `i2`; six projected coordinates, 24).
+/// formulation, from secondary sources), so its own tally, if any, is not checked here.
+/// **Measured** per lane (pinned in `tests/suite/opcount.rs`): a triangle behind the origin
+/// (the plane rejects) 6 mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit 14 mul, 17
+/// add, 3 div, 6 cmp; precomputation 9 mul, 11 add, 3 cmp. **Record:** 42 bytes (the plane, 16;
+/// the two axes, 2 bytes as the Gem's `i1`, `i2`; six projected coordinates, 24).
 ///
 /// **Limits.** Not watertight (the edges are tested in each triangle's own projection, after
 /// the rounded `t`), and `t`, `u`, `v` carry the rounding of the stored plane. **Edge cases.**

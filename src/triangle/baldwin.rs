@@ -35,9 +35,10 @@ use crate::vec3::V3;
 /// A hit needs `t_min < t < t_max`, then `u ≥ 0`, `v ≥ 0`, `u + v ≤ 1`.
 ///
 /// **Claimed count.** not quoted: the paper's text was not available to this study (only its
-/// formulation, from secondary sources), so its own tally, if any, is not checked here. **Measured** per lane (pinned in `tests/suite/opcount.rs`): a
-/// triangle behind the origin 6 mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit
-/// 15 mul, 15 add, 1 div, 5 cmp; precomputation 22 mul, 15 add, 1 div, 3 cmp. **Record:** 48 bytes.
+/// formulation, from secondary sources), so its own tally, if any, is not checked here.
+/// **Measured** per lane (pinned in `tests/suite/opcount.rs`): a triangle behind the origin 6
+/// mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit 15 mul, 15 add, 1 div, 5 cmp;
+/// precomputation 22 mul, 15 add, 1 div, 3 cmp. **Record:** 48 bytes.
 ///
 /// **Limits.** Not watertight; `M` is rounded once per triangle, so `t`, `u`, `v` carry its
 /// rounding. **Edge cases.** A ray parallel to the plane (`e = 0`) gives an infinite or NaN

@@ -27,10 +27,10 @@ use crate::vec3::V3;
 /// one division (see [`triangle`](super) on deferred division). Front faces have `det < 0`.
 ///
 /// **Claimed count.** not quoted: the paper's text was not available to this study (only its
-/// formulation, from secondary sources), so its own tally, if any, is not checked here. **Measured** per
-/// lane (pinned in `tests/suite/opcount.rs`): miss 20 mul, 16 add, 5 cmp; hit 21 mul, 16 add,
-/// 1 div, 10 cmp; behind the origin 20 mul, 16 add, 7 cmp; precomputation 36 mul, 23 add,
-/// 1 div. **Record:** 48 bytes.
+/// formulation, from secondary sources), so its own tally, if any, is not checked here.
+/// **Measured** per lane (pinned in `tests/suite/opcount.rs`): miss 20 mul, 16 add, 5 cmp; hit
+/// 21 mul, 16 add, 1 div, 10 cmp; behind the origin 20 mul, 16 add, 7 cmp; precomputation 36
+/// mul, 23 add, 1 div. **Record:** 48 bytes.
 ///
 /// **Limits.** Not watertight; the scaled planes are rounded once per triangle, and `U`, `V`
 /// grow with the distance of the origin from the triangle (`P'` is formed before anything is

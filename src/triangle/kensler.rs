@@ -21,9 +21,9 @@ use crate::ray::RayPacket;
 /// faces have `n·d < 0`.
 ///
 /// **Claimed count.** not quoted: the paper's text was not available to this study (only its
-/// formulation, from secondary sources), so its own tally, if any, is not checked here. **Measured** per lane (pinned in
-/// `tests/suite/opcount.rs`): miss 23 mul, 22 add, 1 div, 3 cmp; hit 27 mul, 24 add, 1 div,
-/// 5 cmp.
+/// formulation, from secondary sources), so its own tally, if any, is not checked here.
+/// **Measured** per lane (pinned in `tests/suite/opcount.rs`): miss 23 mul, 22 add, 1 div, 3
+/// cmp; hit 27 mul, 24 add, 1 div, 5 cmp.
 ///
 /// **Limits.** Not watertight (`c` differs between triangles that share an edge), and the
 /// reciprocal rounds once more than a division. **Edge cases.** `n·d = 0` makes `k` infinite and

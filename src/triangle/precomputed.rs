@@ -36,7 +36,8 @@ pub trait PrecomputedKernel {
     /// The records of the triangles in `tri`'s lanes.
     fn precompute<L: Lane>(tri: &TrianglePacket<L>) -> Self::Prim<L>;
     /// The hit of each ray lane on the record in the same lane (as
-    /// [`TriangleKernel::intersect`](super::TriangleKernel::intersect): `u`, `v` may be deferred, see [`LaneHit::normalized`]).
+    /// [`TriangleKernel::intersect`](super::TriangleKernel::intersect): `u`, `v` may be
+    /// deferred, see [`LaneHit::normalized`]).
     fn test<L: Lane>(ray: &RayPacket<L>, pre: &Self::Prim<L>, cull: Cull) -> LaneHit<L>;
 }
 

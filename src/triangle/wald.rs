@@ -26,11 +26,11 @@ use crate::ray::RayPacket;
 /// multiply, as in the thesis.
 ///
 /// **Claimed count.** not quoted: the paper's text was not available to this study (only its
-/// formulation, from secondary sources), so its own tally, if any, is not checked here. **Measured** per lane (pinned in
-/// `tests/suite/opcount.rs`): a triangle behind the origin 5 mul, 5 add, 1 div, 2 cmp; a miss
-/// beyond edge BC and a hit 11 mul, 12 add, 1 div, 5 cmp; precomputation 20 mul, 13 add,
-/// 1 div, 4 cmp. **Record:** 37 bytes (nine floats and the axis with the sign of `N_k` in
-/// one byte; the thesis pads its `TriAccel` to 48).
+/// formulation, from secondary sources), so its own tally, if any, is not checked here.
+/// **Measured** per lane (pinned in `tests/suite/opcount.rs`): a triangle behind the origin 5
+/// mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit 11 mul, 12 add, 1 div, 5 cmp;
+/// precomputation 20 mul, 13 add, 1 div, 4 cmp. **Record:** 37 bytes (nine floats and the axis
+/// with the sign of `N_k` in one byte; the thesis pads its `TriAccel` to 48).
 ///
 /// **Limits.** Not watertight; the scaled plane and lines are rounded once per triangle, so
 /// `t`, `u`, `v` carry their rounding. **Edge cases.** A ray parallel to the plane makes the
