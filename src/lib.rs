@@ -62,6 +62,7 @@ pub mod opcount;
 pub mod plane;
 pub mod ray;
 pub mod sphere;
+pub mod study;
 pub mod triangle;
 pub mod vec3;
 #[cfg(feature = "vectors")]

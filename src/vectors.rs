@@ -33,12 +33,12 @@ use crate::plane::{self, FocalPlane, Plane, PlanePacket};
 use crate::ray::RayPacket;
 use crate::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
 use crate::sphere::{
-    FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Roots, Sphere, SphereKernel,
-    SpherePacket,
+    EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust, Roots, Sphere,
+    SphereKernel, SpherePacket,
 };
 use crate::triangle::{
-    self, Cramer, Cull, FocalRays, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket,
-    Watertight,
+    self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout,
+    KenslerShirley, Moller, Plucker, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
 };
 use crate::vec3::V3;
 
@@ -328,11 +328,27 @@ pub enum Method {
     Moller,
     /// [`Watertight`]: triangles (Woop, Benthin, Wald 2013).
     Watertight,
+    /// [`Pbrt`]: spheres (pbrt-v4's sphere test, without intervals).
+    Pbrt,
+    /// [`EmbreeSphere`]: spheres (Embree's sphere test).
+    EmbreeSphere,
+    /// [`Badouel`]: triangles (Badouel 1990: plane, then a 2-D test (precomputed plane)).
+    Badouel,
+    /// [`Plucker`]: triangles (Plücker edge tests relative to the origin (Segura–Feito 1998, as in Embree)).
+    Plucker,
+    /// [`Wald`]: triangles (Wald 2004: precomputed projection).
+    Wald,
+    /// [`HavelHerout`]: triangles (Havel–Herout 2010: precomputed planes).
+    HavelHerout,
+    /// [`KenslerShirley`]: triangles (Kensler–Shirley 2006).
+    KenslerShirley,
+    /// [`BaldwinWeber`]: triangles (Baldwin–Weber 2016: precomputed affine transform).
+    BaldwinWeber,
 }
 
 impl Method {
     /// Every method, in report order.
-    pub const ALL: [Method; 10] = [
+    pub const ALL: [Method; 18] = [
         Method::Quadratic,
         Method::QuadraticUnit,
         Method::Geometric,
@@ -343,6 +359,14 @@ impl Method {
         Method::Cramer,
         Method::Moller,
         Method::Watertight,
+        Method::Pbrt,
+        Method::EmbreeSphere,
+        Method::Badouel,
+        Method::Plucker,
+        Method::Wald,
+        Method::HavelHerout,
+        Method::KenslerShirley,
+        Method::BaldwinWeber,
     ];
 
     /// The checker's name.
@@ -359,6 +383,14 @@ impl Method {
             Method::Cramer => Cramer::NAME,
             Method::Moller => Moller::NAME,
             Method::Watertight => Watertight::NAME,
+            Method::Pbrt => Pbrt::NAME,
+            Method::EmbreeSphere => EmbreeSphere::NAME,
+            Method::Badouel => Badouel::NAME,
+            Method::Plucker => Plucker::NAME,
+            Method::Wald => Wald::NAME,
+            Method::HavelHerout => HavelHerout::NAME,
+            Method::KenslerShirley => KenslerShirley::NAME,
+            Method::BaldwinWeber => BaldwinWeber::NAME,
         }
     }
 
@@ -372,16 +404,26 @@ impl Method {
     #[must_use]
     pub fn applies(self, kind: Kind) -> bool {
         match kind {
-            Kind::Sphere => !matches!(
-                self,
-                Method::Plane | Method::Cramer | Method::Moller | Method::Watertight
-            ),
+            Kind::Sphere => !matches!(self, Method::Plane) && !self.triangles_only(),
             Kind::Plane => matches!(self, Method::Plane | Method::Focal),
-            Kind::Triangle => matches!(
-                self,
-                Method::Cramer | Method::Moller | Method::Watertight | Method::Focal
-            ),
+            Kind::Triangle => matches!(self, Method::Focal) || self.triangles_only(),
         }
+    }
+
+    /// The methods that test triangles only.
+    fn triangles_only(self) -> bool {
+        matches!(
+            self,
+            Method::Cramer
+                | Method::Moller
+                | Method::Watertight
+                | Method::Badouel
+                | Method::Plucker
+                | Method::Wald
+                | Method::HavelHerout
+                | Method::KenslerShirley
+                | Method::BaldwinWeber
+        )
     }
 
     /// The crate's recommended general method for a kind (any direction, any origin).
@@ -457,7 +499,7 @@ mod limits {
     /// The triangle methods' limits on the values of a hit: measured error models
     /// (`tests/vectors/triangle_*.txt`) against the case's tolerance ([`super::tolerance`]).
     fn triangle(m: Method, case: &Case) -> Limit {
-        let (a, b, c) = (v(case, 6), v(case, 9), v(case, 12));
+        let (o, d, a, b, c) = (v(case, 0), v(case, 3), v(case, 6), v(case, 9), v(case, 12));
         let n = (b - a).cross(c - a);
         let area2 = sqrt(n.dot(n));
         // Misses and degenerate triangles: every method's decisions are compared.
@@ -471,13 +513,43 @@ mod limits {
         let aspect = longest / area2;
         let tol_t = super::tolerance(case, 0);
         match m {
-            Method::Cramer | Method::Moller => {
+            Method::Cramer | Method::Moller | Method::Plucker | Method::KenslerShirley => {
                 // t is a triple product over the determinant, each rounded at the scale of
                 // |e1|·|e2|·|s|: on needles the relative error of t grows with the aspect
                 // ratio while t itself stays well conditioned. Measured (triangle_needle.txt):
-                // at most 1.92·2^-24·aspect.
+                // at most 1.92·2^-24·aspect (Cramer, Möller; Plücker and Kensler–Shirley form
+                // t the same way and pass every case inside this bound).
                 if 2.0 * U * aspect > tol_t {
                     return Limit::Outside("needle: t error up to 2·2^-24·aspect ratio");
+                }
+                Limit::Inside
+            }
+            Method::Badouel | Method::Wald | Method::HavelHerout | Method::BaldwinWeber => {
+                // A record computed once per triangle (plane, lines, transform) carries
+                // coordinates of size M (the largest |coordinate| of the origin and the
+                // vertices) into every test: the plane offset cancels at the scale of M against
+                // the distance `dist` from the origin to the plane, and the lines at the scale
+                // of M against the smallest altitude h. Measured on every triangle file (the
+                // largest ratio over the four methods): relative t error at most
+                // 4.03·2^-24·(M/dist)·(1 + aspect/8), u, v error at most
+                // 2.1·2^-24·M/(h·cos θ)·max(1, aspect/64).
+                let m = [o, a, b, c].iter().fold(0.0f64, |x, p| {
+                    x.max(p.x.abs()).max(p.y.abs()).max(p.z.abs())
+                });
+                let h = area2 / sqrt(longest);
+                let cos = n.dot(d).abs() / (area2 * sqrt(d.dot(d)));
+                let dist = n.dot(a - o).abs() / area2;
+                if 5.0 * U * m / dist * (1.0 + aspect / 8.0) > tol_t {
+                    return Limit::Outside(
+                        "precomputed record: t error up to 4.03·2^-24·(M/dist)·(1 + aspect/8)",
+                    );
+                }
+                let model = U * m / (h * cos);
+                let tol_uv = super::tolerance(case, 1).min(super::tolerance(case, 2));
+                if 3.0 * model * (aspect / 64.0).max(1.0) > tol_uv {
+                    return Limit::Outside(
+                        "precomputed record: u, v error up to 2·2^-24·M/(h·cos θ)·max(1, aspect/64)",
+                    );
                 }
                 Limit::Inside
             }
@@ -549,7 +621,7 @@ mod limits {
                 }
                 Limit::Inside
             }
-            Method::Robust => {
+            Method::Robust | Method::Pbrt | Method::EmbreeSphere => {
                 // |l| carries an error of about 8·2^-24·|f|; c = f·f − r² about 4·2^-24·|f|².
                 let el = 8.0 * U * c;
                 let l = sqrt(l2);
@@ -573,7 +645,7 @@ mod limits {
             // Exact decisions and t within 2^-17 for unit directions and any c/r.
             Method::Focal | Method::Plane => Limit::Inside,
             // Triangle methods never reach here (only sphere cases are limited).
-            Method::Cramer | Method::Moller | Method::Watertight => Limit::Inside,
+            _ => Limit::Inside,
         }
     }
 }
@@ -642,6 +714,8 @@ fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outco
                 Method::QuadraticUnit => QuadraticUnit::roots(&ray, &spheres()),
                 Method::Geometric => Geometric::roots(&ray, &spheres()),
                 Method::Robust => Robust::roots(&ray, &spheres()),
+                Method::Pbrt => Pbrt::roots(&ray, &spheres()),
+                Method::EmbreeSphere => EmbreeSphere::roots(&ray, &spheres()),
                 Method::Focal | Method::FocalUnguarded => {
                     let mut e =
                         [FocalSphere::<f32>::new(Vec3::ZERO, &Sphere::new(Vec3::ZERO, f32::NAN));
@@ -707,6 +781,12 @@ fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outco
                 Method::Cramer => tri_lanes::<Cramer, L>(&ray, &tris),
                 Method::Moller => tri_lanes::<Moller, L>(&ray, &tris),
                 Method::Watertight => tri_lanes::<Watertight, L>(&ray, &tris),
+                Method::Badouel => tri_lanes::<Badouel, L>(&ray, &tris),
+                Method::Plucker => tri_lanes::<Plucker, L>(&ray, &tris),
+                Method::Wald => tri_lanes::<Wald, L>(&ray, &tris),
+                Method::HavelHerout => tri_lanes::<HavelHerout, L>(&ray, &tris),
+                Method::KenslerShirley => tri_lanes::<KenslerShirley, L>(&ray, &tris),
+                Method::BaldwinWeber => tri_lanes::<BaldwinWeber, L>(&ray, &tris),
                 _ => {
                     // A per-case cache with the eye at the ray origin.
                     let mut e = [FocalTriangle::never(); MAX_LANES];
@@ -1172,7 +1252,7 @@ pub mod accuracy {
     ) -> fmt::Result {
         for kind in [Kind::Triangle, Kind::Sphere, Kind::Plane] {
             let classes = || CLASSES.iter().filter(move |c| c.kind == kind);
-            let mut table = [[Errors::default(); 6]; 6];
+            let mut table = [[Errors::default(); Method::ALL.len()]; CLASSES.len()];
             for (i, c) in classes().enumerate() {
                 for (j, m) in methods(kind).enumerate() {
                     table[i][j] = errors(m, c);

@@ -1,4 +1,4 @@
-//! Ray–sphere intersection: four formulations over one lane abstraction.
+//! Ray–sphere intersection: six formulations over one lane abstraction.
 //!
 //! | kernel | from | directions | strength |
 //! | --- | --- | --- | --- |
@@ -6,6 +6,8 @@
 //! | [`QuadraticUnit`] | the brute force of lecture 000 with `a = 1` | unit | the lecture's operation count |
 //! | [`Geometric`] | the lecture's "faster method" (Glassner) | unit | fewest operations for a single ray |
 //! | [`Robust`] | Ray Tracing Gems ch. 7 (precision lecture 001) | any | perpendicular-distance discriminant, stable roots |
+//! | [`Pbrt`] | pbrt-v4's `Sphere::BasicIntersect` (intervals aside) | any | the same perpendicular as [`Robust`], discriminant as (r + ℓ)(r − ℓ) with ℓ = \|v\| |
+//! | [`EmbreeSphere`] | Embree's `sphere_intersector.h` | any | perpendicular foot, roots τ ∓ h |
 //! | [`focal`] | rays from one focal point, cached per sphere, with a precision guard | unit | 4 mul + 2 add per miss, exact hit/miss decisions to c/r = 2^20 |
 //!
 //! Every kernel returns all roots inside the ray's open interval, ascending ([`Roots`]): both
@@ -20,12 +22,16 @@
 //! number is stored with a NaN radius by [`Sphere::new`] and never hit; bad rays are
 //! sanitised by their constructors (see [`ray`](crate::ray)).
 
+mod embree;
 pub mod focal;
 mod geometric;
+mod pbrt;
 mod quadratic;
 mod robust;
 
+pub use embree::EmbreeSphere;
 pub use geometric::{Geometric, Prepared};
+pub use pbrt::Pbrt;
 pub use quadratic::{Quadratic, QuadraticUnit};
 pub use robust::Robust;
 

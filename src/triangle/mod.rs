@@ -1,10 +1,16 @@
-//! Ray–triangle intersection: four formulations over one lane abstraction.
+//! Ray–triangle intersection: ten formulations over one lane abstraction.
 //!
 //! | kernel | from | per-ray setup | watertight | strength |
 //! | --- | --- | --- | --- | --- |
 //! | [`Cramer`] | lecture 002: the 3×3 system by Cramer's rule | none | no | the textbook; three divisions, early exits |
 //! | [`Moller`] | Möller & Trumbore 1997, division deferred (as in Embree) | none | no | fewest operations without per-ray setup |
 //! | [`Watertight`] | Woop, Benthin & Wald 2013 | shear, 3 div | yes (no leaks; edges may be hit twice) | any ray, any triangle |
+//! | [`Badouel`] | Badouel 1990: plane, then a 2-D test | plane and projection per triangle ([`PrecomputedKernel`]) | no | the plane rejects first |
+//! | [`Plucker`] | Segura & Feito 1998, as in Embree's Plücker test | none | no leaks (edges may be hit twice) | edge tests exact in sign across shared edges |
+//! | [`Wald`] | Wald 2004 (thesis): precomputed projection | 37-byte record per triangle | no | fewest operations per hit of the published tests |
+//! | [`HavelHerout`] | Havel & Herout 2010: three precomputed planes | 48-byte record | no | no branch before the sign test |
+//! | [`KenslerShirley`] | Kensler & Shirley 2006 | none | no | one reciprocal for t, u, v |
+//! | [`BaldwinWeber`] | Baldwin & Weber 2016: precomputed affine transform | 48-byte record | no | no per-triangle axis in the test |
 //! | [`focal`] | rays from one focal point, edge normals cached per triangle (exactly rounded) | exact power-of-two scale | yes, and each crossing is reported once (exact decisions, a stated fill rule) | 9 mul + 6 add per miss; `t`, `u`, `v` measured at most 2× Möller's error |
 //!
 //! **Conventions.** A hit satisfies `o + t·d = A + u(B − A) + v(C − A)` with `t_min < t <
@@ -49,15 +55,29 @@
 //! assert_eq!(hits.lane(7).unwrap().t, 5.0);
 //! ```
 
+mod badouel;
+mod baldwin;
 mod cramer;
 pub mod exact;
 pub mod focal;
+mod havel;
+mod kensler;
 mod moller;
+mod plucker;
+mod precomputed;
+mod wald;
 mod watertight;
 
+pub use badouel::{Badouel, BadouelRecord};
+pub use baldwin::{AffineRecord, BaldwinWeber};
 pub use cramer::Cramer;
 pub use focal::{FocalRays, FocalTriangle};
+pub use havel::{HavelHerout, PlanesRecord};
+pub use kensler::KenslerShirley;
 pub use moller::Moller;
+pub use plucker::Plucker;
+pub use precomputed::{PrecomputedKernel, closest_precomputed, precompute_all};
+pub use wald::{Wald, WaldRecord};
 pub use watertight::{Shear, Watertight};
 
 use glam::Vec3;

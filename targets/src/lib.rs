@@ -16,10 +16,12 @@ use raylane::mesh::Mesh;
 use raylane::plane::{self, FocalPlane, Plane};
 use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
 use raylane::sphere::{
-    self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere, SpherePacket,
+    self, EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust, Sphere,
+    SpherePacket,
 };
 use raylane::triangle::{
-    self, Cramer, Cull, FocalRays, FocalTriangle, Moller, Triangle, TrianglePacket, Watertight,
+    self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout,
+    KenslerShirley, Moller, Plucker, Triangle, TrianglePacket, Wald, Watertight,
 };
 use raylane::vectors::{Case, Kind, Values};
 use raylane::{Hit, Lane, Mask, Ray, RayPacket};
@@ -166,6 +168,8 @@ pub fn every_kernel<L: Lane<Scalar = f32>>(rays: &RayPacket<L>, ray: &Ray) {
     hits(&sphere::closest::<QuadraticUnit, L>(rays, &balls));
     hits(&sphere::closest::<Geometric, L>(rays, &balls));
     hits(&sphere::closest::<Robust, L>(rays, &balls));
+    hits(&sphere::closest::<Pbrt, L>(rays, &balls));
+    hits(&sphere::closest::<EmbreeSphere, L>(rays, &balls));
     sink(sphere::any::<Robust, L>(rays, &balls).bits());
     sphere::all::<Robust, L>(rays, &balls, |i, r| sink(i ^ r.any().bits()));
     let mut packed = [SpherePacket::<L>::from_spheres(&[]); 1];
@@ -197,6 +201,24 @@ pub fn every_kernel<L: Lane<Scalar = f32>>(rays: &RayPacket<L>, ray: &Ray) {
     hits(&triangle::closest::<Cramer, L>(rays, &tris, Cull::None));
     hits(&triangle::closest::<Moller, L>(rays, &tris, Cull::Back));
     hits(&triangle::closest::<Watertight, L>(rays, &tris, Cull::None));
+    hits(&triangle::closest::<Badouel, L>(rays, &tris, Cull::None));
+    hits(&triangle::closest::<Plucker, L>(rays, &tris, Cull::None));
+    hits(&triangle::closest::<Wald, L>(rays, &tris, Cull::None));
+    hits(&triangle::closest::<HavelHerout, L>(
+        rays,
+        &tris,
+        Cull::None,
+    ));
+    hits(&triangle::closest::<KenslerShirley, L>(
+        rays,
+        &tris,
+        Cull::None,
+    ));
+    hits(&triangle::closest::<BaldwinWeber, L>(
+        rays,
+        &tris,
+        Cull::None,
+    ));
     sink(triangle::any::<Watertight, L>(rays, &tris, Cull::None).bits());
     triangle::all::<Moller, L>(rays, &tris, Cull::None, |i, h| sink(i ^ h.mask.bits()));
     let mut tpacked = [TrianglePacket::<L>::from_triangles(&[]); 1];

@@ -5,8 +5,8 @@ use glam::Vec3;
 use raylane::plane::{self, FocalPlane, Plane};
 use raylane::sphere::focal::{self, Focal, FocalUnguarded};
 use raylane::sphere::{
-    self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere, SphereKernel,
-    SpherePacket,
+    self, EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust, Sphere,
+    SphereKernel, SpherePacket,
 };
 use raylane::{Lane, Ray, RayPacket};
 use wide::f32x8;
@@ -71,6 +71,8 @@ fn every_kernel_misses(ray: &Ray, s: &Sphere, what: &str) {
     misses::<QuadraticUnit>(ray, s, what);
     misses::<Geometric>(ray, s, what);
     misses::<Robust>(ray, s, what);
+    misses::<Pbrt>(ray, s, what);
+    misses::<EmbreeSphere>(ray, s, what);
     for (name, e) in [
         ("focal", FocalSphere::new(ray.origin(), s)),
         ("unguarded", FocalSphere::unguarded(ray.origin(), s)),

@@ -8,8 +8,8 @@ use raylane::lane::{Lane, Mask};
 use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
 use raylane::sphere::focal::{self, Focal, FocalKernel, FocalUnguarded};
 use raylane::sphere::{
-    self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Roots, Sphere, SphereKernel,
-    SpherePacket,
+    self, EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust, Roots,
+    Sphere, SphereKernel, SpherePacket,
 };
 use raylane::{Hit, Ray, RayPacket, V3};
 use wide::{f32x4, f32x8, f32x16};
@@ -159,6 +159,8 @@ fn every_kernel<L: Lane<Scalar = f32>>(seed: u64) {
         kernel::<QuadraticUnit, L>(&rays[..n], &spheres);
         kernel::<Geometric, L>(&rays[..n], &spheres);
         kernel::<Robust, L>(&rays[..n], &spheres);
+        kernel::<Pbrt, L>(&rays[..n], &spheres);
+        kernel::<EmbreeSphere, L>(&rays[..n], &spheres);
         focal_kernel::<Focal, L>(&rays[..n], &spheres, true);
         focal_kernel::<FocalUnguarded, L>(&rays[..n], &spheres, false);
         let ps: Vec<Plane> = spheres

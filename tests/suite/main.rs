@@ -14,6 +14,8 @@ mod opcount;
 mod readme;
 #[cfg(feature = "demo")]
 mod render;
+#[cfg(feature = "vectors")]
+mod study;
 mod triangles;
 #[cfg(feature = "vectors")]
 mod vectors;

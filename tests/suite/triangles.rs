@@ -14,8 +14,9 @@ use raylane::mesh::Mesh;
 use raylane::opcount::{OpCounts, table};
 use raylane::triangle::focal as tf;
 use raylane::triangle::{
-    self, Cramer, Cull, FocalRays, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket,
-    Watertight,
+    self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout,
+    KenslerShirley, Moller, Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket,
+    Wald, Watertight,
 };
 use raylane::{Hit, LaneHit, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
@@ -131,6 +132,12 @@ fn every_kernel<L: Lane<Scalar = f32>>(seed: u64) {
         kernel::<Cramer, L>(&rays[..n], &tris);
         kernel::<Moller, L>(&rays[..n], &tris);
         kernel::<Watertight, L>(&rays[..n], &tris);
+        kernel::<Badouel, L>(&rays[..n], &tris);
+        kernel::<Plucker, L>(&rays[..n], &tris);
+        kernel::<Wald, L>(&rays[..n], &tris);
+        kernel::<HavelHerout, L>(&rays[..n], &tris);
+        kernel::<KenslerShirley, L>(&rays[..n], &tris);
+        kernel::<BaldwinWeber, L>(&rays[..n], &tris);
         focal_kernel::<L>(&rays[..n], &tris);
     }
 }
@@ -306,6 +313,30 @@ fn entry_points_of<K: TriangleKernel, L: Lane<Scalar = f32>>(
     }
 }
 
+/// Stored records give the hits of the kernel that precomputes per query, bit for bit.
+fn stored_records<K, L>(rays: &[Ray], tris: &[Triangle], cull: Cull)
+where
+    K: PrecomputedKernel + TriangleKernel,
+    L: Lane<Scalar = f32>,
+{
+    let rp = RayPacket::<L>::from_rays(rays);
+    let mut records = vec![K::precompute(&TrianglePacket::<L>::splat(&tris[0])); tris.len()];
+    assert_eq!(
+        triangle::precompute_all::<K, L>(tris, &mut records),
+        tris.len()
+    );
+    let stored = triangle::closest_precomputed::<K, L>(&rp, &records, cull);
+    let fresh = triangle::closest::<K, L>(&rp, tris, cull);
+    for i in 0..rays.len() {
+        assert_eq!(
+            stored.lane(i),
+            fresh.lane(i),
+            "{} stored, lane {i}",
+            <K as TriangleKernel>::NAME
+        );
+    }
+}
+
 fn focal_entry_points<L: Lane<Scalar = f32>>(
     eye: Vec3,
     rays: &[Ray],
@@ -393,6 +424,12 @@ fn entry_points<L: Lane<Scalar = f32>>(seed: u64) {
             entry_points_of::<Cramer, L>(&rays, &tris, &mesh, cull);
             entry_points_of::<Moller, L>(&rays, &tris, &mesh, cull);
             entry_points_of::<Watertight, L>(&rays, &tris, &mesh, cull);
+            entry_points_of::<Plucker, L>(&rays, &tris, &mesh, cull);
+            entry_points_of::<Wald, L>(&rays, &tris, &mesh, cull);
+            stored_records::<Wald, L>(&rays, &tris, cull);
+            stored_records::<Badouel, L>(&rays, &tris, cull);
+            stored_records::<HavelHerout, L>(&rays, &tris, cull);
+            stored_records::<BaldwinWeber, L>(&rays, &tris, cull);
             entry_points_of::<Moller, L>(&rays[..1], &tris[..1], &mesh, cull);
             // Rays from one eye for the focal caches.
             let eye = Vec3::new(
@@ -426,6 +463,12 @@ fn bad_input_is_a_miss() {
             triangle::intersect::<Cramer>(r, t, Cull::None),
             triangle::intersect::<Moller>(r, t, Cull::None),
             triangle::intersect::<Watertight>(r, t, Cull::None),
+            triangle::intersect::<Badouel>(r, t, Cull::None),
+            triangle::intersect::<Plucker>(r, t, Cull::None),
+            triangle::intersect::<Wald>(r, t, Cull::None),
+            triangle::intersect::<HavelHerout>(r, t, Cull::None),
+            triangle::intersect::<KenslerShirley>(r, t, Cull::None),
+            triangle::intersect::<BaldwinWeber>(r, t, Cull::None),
             tf::intersect(r, &FocalTriangle::new(r.origin(), t), Cull::None),
         ]
     };
@@ -480,11 +523,23 @@ fn bad_input_is_a_miss() {
     assert!(triangle::intersect::<Moller>(&down, &good, Cull::Back).is_some());
     assert!(triangle::intersect::<Cramer>(&down, &good, Cull::Back).is_some());
     assert!(triangle::intersect::<Watertight>(&down, &good, Cull::Back).is_some());
+    assert!(triangle::intersect::<Badouel>(&down, &good, Cull::Back).is_some());
+    assert!(triangle::intersect::<Plucker>(&down, &good, Cull::Back).is_some());
+    assert!(triangle::intersect::<Wald>(&down, &good, Cull::Back).is_some());
+    assert!(triangle::intersect::<HavelHerout>(&down, &good, Cull::Back).is_some());
+    assert!(triangle::intersect::<KenslerShirley>(&down, &good, Cull::Back).is_some());
+    assert!(triangle::intersect::<BaldwinWeber>(&down, &good, Cull::Back).is_some());
     assert!(tf::intersect(&down, &FocalTriangle::new(down.origin(), &good), Cull::Back).is_some());
     for h in [
         triangle::intersect::<Moller>(&up, &good, Cull::Back),
         triangle::intersect::<Cramer>(&up, &good, Cull::Back),
         triangle::intersect::<Watertight>(&up, &good, Cull::Back),
+        triangle::intersect::<Badouel>(&up, &good, Cull::Back),
+        triangle::intersect::<Plucker>(&up, &good, Cull::Back),
+        triangle::intersect::<Wald>(&up, &good, Cull::Back),
+        triangle::intersect::<HavelHerout>(&up, &good, Cull::Back),
+        triangle::intersect::<KenslerShirley>(&up, &good, Cull::Back),
+        triangle::intersect::<BaldwinWeber>(&up, &good, Cull::Back),
         tf::intersect(&up, &FocalTriangle::new(up.origin(), &good), Cull::Back),
     ] {
         assert_eq!(h, None);
@@ -914,6 +969,12 @@ fn kernels_agree_with_each_other() {
                 triangle::intersect::<Cramer>(&r, &t, cull),
                 triangle::intersect::<Moller>(&r, &t, cull),
                 triangle::intersect::<Watertight>(&r, &t, cull),
+                triangle::intersect::<Badouel>(&r, &t, cull),
+                triangle::intersect::<Plucker>(&r, &t, cull),
+                triangle::intersect::<Wald>(&r, &t, cull),
+                triangle::intersect::<HavelHerout>(&r, &t, cull),
+                triangle::intersect::<KenslerShirley>(&r, &t, cull),
+                triangle::intersect::<BaldwinWeber>(&r, &t, cull),
                 tf::intersect(&r, &FocalTriangle::new(o, &t), cull),
             ];
             let inside = u >= 0.0 && w >= 0.0 && u + w <= 1.0;

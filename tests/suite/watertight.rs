@@ -5,7 +5,7 @@
 //! outside is aimed through a surface point `P` and then through a point `Q` strictly inside
 //! the (convex) mesh, so it crosses twice; a ray from an inside point crosses once. Hits are
 //! grouped by `t` (relative gap 1e-5): a **leak** is a ray with fewer groups than crossings,
-//! a **double hit** a group reported by more than one triangle. Required: no leak for
+//! a **double hit** a group reported by more than one triangle. Required: no leak for `plucker`,
 //! `watertight` and `focal`, and no double hit for `focal`; the counts of `moller` and `cramer`
 //! are printed (`cargo test --test watertight -- --nocapture`).
 
@@ -18,7 +18,8 @@ use raylane::V3;
 use raylane::demo::shapes;
 use raylane::mesh::Mesh;
 use raylane::triangle::{
-    Cramer, Cull, FocalRays, FocalTriangle, Moller, TriangleKernel, Watertight,
+    Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout, KenslerShirley,
+    Moller, Plucker, TriangleKernel, Wald, Watertight,
 };
 use raylane::{Ray, RayPacket};
 
@@ -263,11 +264,48 @@ fn cases(s: &Shape, seed: u64) -> Vec<Case> {
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-enum Method {
+pub enum Method {
     Cramer,
     Moller,
     Watertight,
     Focal,
+    Badouel,
+    Plucker,
+    Wald,
+    HavelHerout,
+    KenslerShirley,
+    BaldwinWeber,
+}
+
+impl Method {
+    pub const ALL: [Method; 10] = [
+        Method::Cramer,
+        Method::Moller,
+        Method::Watertight,
+        Method::Focal,
+        Method::Badouel,
+        Method::Plucker,
+        Method::Wald,
+        Method::HavelHerout,
+        Method::KenslerShirley,
+        Method::BaldwinWeber,
+    ];
+
+    /// The checker's name (the study table's row).
+    pub fn name(self) -> &'static str {
+        match self {
+            Method::Cramer => Cramer::NAME,
+            Method::Moller => Moller::NAME,
+            Method::Watertight => Watertight::NAME,
+            Method::Focal => "focal",
+            Method::Badouel => Badouel::NAME,
+            Method::Plucker => Plucker::NAME,
+            Method::Wald => Wald::NAME,
+            Method::HavelHerout => HavelHerout::NAME,
+            Method::KenslerShirley => KenslerShirley::NAME,
+            Method::BaldwinWeber => BaldwinWeber::NAME,
+        }
+    }
 }
 
 /// All hits `(t, triangle)` of one ray.
@@ -290,6 +328,12 @@ fn hits(m: Method, s: &Shape, ray: &Ray, cache: &mut [FocalTriangle<f32>]) -> Ve
         Method::Cramer => run::<Cramer>(&mesh, &rp, &mut push),
         Method::Moller => run::<Moller>(&mesh, &rp, &mut push),
         Method::Watertight => run::<Watertight>(&mesh, &rp, &mut push),
+        Method::Badouel => run::<Badouel>(&mesh, &rp, &mut push),
+        Method::Plucker => run::<Plucker>(&mesh, &rp, &mut push),
+        Method::Wald => run::<Wald>(&mesh, &rp, &mut push),
+        Method::HavelHerout => run::<HavelHerout>(&mesh, &rp, &mut push),
+        Method::KenslerShirley => run::<KenslerShirley>(&mesh, &rp, &mut push),
+        Method::BaldwinWeber => run::<BaldwinWeber>(&mesh, &rp, &mut push),
         Method::Focal => {
             let fm = mesh.focus(ray.origin(), cache);
             fm.all(&FocalRays::new(&rp), Cull::None, &mut push);
@@ -299,12 +343,30 @@ fn hits(m: Method, s: &Shape, ray: &Ray, cache: &mut [FocalTriangle<f32>]) -> Ve
     out
 }
 
-#[derive(Default, Clone, Copy, Debug)]
-struct Tally {
-    rays: usize,
-    leaks: usize,
-    doubles: usize,
-    extra: usize,
+/// Rays shot, and how many leaked, were hit twice at one crossing, or had extra crossings.
+#[derive(Default, Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Tally {
+    pub rays: usize,
+    pub leaks: usize,
+    pub doubles: usize,
+    pub extra: usize,
+}
+
+/// The closed meshes of the test: an icosphere, a cube and a double cone.
+fn shapes() -> [Shape; 3] {
+    [icosphere(4), cube(), double_cone()]
+}
+
+/// One method's totals over every mesh and ray of the test (the study table's columns).
+pub fn totals(m: Method) -> Tally {
+    let mut t = Tally::default();
+    for (si, s) in shapes().iter().enumerate() {
+        let mut cache = vec![FocalTriangle::never(); s.idx.len()];
+        for c in &cases(s, 7 + si as u64) {
+            judge(&hits(m, s, &c.ray, &mut cache), c.crossings, &mut t);
+        }
+    }
+    t
 }
 
 /// Groups hits by `t` and compares with the expected crossings.
@@ -333,13 +395,8 @@ fn judge(h: &[(f32, u32)], crossings: usize, t: &mut Tally) {
 
 #[test]
 fn closed_meshes_leak_and_double_hit_counts() {
-    let shapes = [icosphere(4), cube(), double_cone()];
-    let methods = [
-        Method::Cramer,
-        Method::Moller,
-        Method::Watertight,
-        Method::Focal,
-    ];
+    let shapes = shapes();
+    let methods = Method::ALL;
     let mut total: HashMap<(Method, Target), Tally> = HashMap::new();
     println!("watertightness: rays aimed at shared vertices/edges and random surface points");
     println!("| mesh | method | target | rays | leaks | double hits | extra hits |");
@@ -392,7 +449,7 @@ fn closed_meshes_leak_and_double_hit_counts() {
             t.rays, t.leaks, t.doubles, t.extra
         );
         match m {
-            Method::Watertight => assert_eq!(t.leaks, 0, "watertight leaks"),
+            Method::Watertight | Method::Plucker => assert_eq!(t.leaks, 0, "{m:?} leaks"),
             Method::Focal => {
                 assert_eq!(t.leaks, 0, "focal leaks");
                 assert_eq!(t.doubles, 0, "focal double hits");
