@@ -45,7 +45,7 @@
 
 use glam::Vec3;
 
-use super::{Robust, Roots, Sphere, SphereKernel, SpherePacket};
+use super::{Roots, Sphere, SpherePacket};
 use crate::hit::{self, HitRecord};
 use crate::lane::{Lane, Mask};
 use crate::ray::{Ray, RayPacket};
@@ -151,7 +151,11 @@ impl FocalSphere<f32> {
             );
         }
         if !guarded {
-            return entry(k as f32, f32::NEG_INFINITY, f32::INFINITY, f32::INFINITY);
+            // Outside c ≤ 2^30, 2^-30 ≤ r ≤ 2^30 the f32 squares lose their range: never hit.
+            let range = (1.0 / 1_073_741_824.0)..=1_073_741_824.0;
+            let fits = c2 <= sq(*range.end()) && range.contains(&r);
+            let k_lo = if fits { k as f32 } else { f32::INFINITY };
+            return entry(k_lo, f32::NEG_INFINITY, f32::INFINITY, f32::INFINITY);
         }
         let c = libm::sqrt(c2);
         if !(c <= 1.0e18 && (1.0e-12..=1.0e18).contains(&r)) {
@@ -210,6 +214,21 @@ impl FocalSphere<f32> {
             l2_miss,
             t_acc,
         )
+    }
+}
+
+impl FocalSphere<f32> {
+    /// An entry whose cheap test passes every ray (`k_lo = −inf`) and which is never hit
+    /// (its sphere is invalid, so the `f64` path misses): what [`Bound::focal`] returns for
+    /// an invalid bound, which must cull nothing.
+    ///
+    /// [`Bound::focal`]: crate::bounds::Bound::focal
+    #[must_use]
+    pub fn pass_all() -> Self {
+        FocalSphere {
+            k_lo: f32::NEG_INFINITY,
+            ..Self::new(Vec3::ZERO, &Sphere::new(Vec3::ZERO, f32::NAN))
+        }
     }
 }
 
@@ -444,27 +463,8 @@ fn hit_path<L: Lane, S: FocalLanes<L>>(
     if doubtful.none() {
         roots
     } else {
-        precise(*ray, s.sphere(), roots, doubtful)
+        super::precise(*ray, s.sphere(), roots, doubtful)
     }
-}
-
-/// Recomputes the `doubtful` lanes with [`Robust`] in `L::Precise` (`f64`). Out of line and
-/// taking its inputs by value, so the callers' ray packets never need an address.
-#[inline(never)]
-fn precise<L: Lane>(
-    ray: RayPacket<L>,
-    s: SpherePacket<L>,
-    mut roots: Roots<L>,
-    doubtful: L::Mask,
-) -> Roots<L> {
-    let mut bits = doubtful.bits();
-    while bits != 0 {
-        let i = bits.trailing_zeros() as usize;
-        let p = Robust::roots(&ray.precise_lane(i), &s.precise_lane(i));
-        roots = roots.with_precise_lane(i, ray.t_min.lane(i), ray.t_max.lane(i), &p);
-        bits &= bits - 1;
-    }
-    roots
 }
 
 /// Closest hit of ray packets from the cache's eye over cached spheres (N rays × 1 sphere).

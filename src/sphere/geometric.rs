@@ -58,21 +58,36 @@ impl Geometric {
         }
     }
 
-    /// The per-ray test with prepared values: the lecture's 4 mul, 3 add on a miss.
+    /// The per-ray test with prepared values: the lecture's 4 mul, 3 add on a miss. Lanes
+    /// outside the range (see [`Geometric`]) are a miss here: prepared values no longer hold
+    /// the sphere for the `f64` fallback that [`SphereKernel::roots`] runs.
     #[inline(always)]
     #[must_use]
     pub fn roots_prepared<L: Lane>(ray: &RayPacket<L>, p: &Prepared<L>) -> Roots<L> {
+        let (roots, _) = Self::body(ray, p);
+        roots
+    }
+
+    /// The body: the roots of lanes in range, and the lanes the range guard sent away.
+    #[inline(always)]
+    fn body<L: Lane>(ray: &RayPacket<L>, p: &Prepared<L>) -> (Roots<L>, L::Mask) {
         // 1. Foot of the perpendicular along the ray.
         let v = p.t.dot(ray.dir);
         // 2. Squared distance from the centre to the ray, against r².
         let b2 = p.c2 - v * v;
-        let real = p.r2.ge(b2);
+        // `!(r² < b²)`: a NaN or infinite b² (squares that overflowed) goes on to the range
+        // guard (`is_finite` is a bit test, not counted).
+        let real = !p.r2.lt(b2) | !b2.is_finite();
         if real.none() {
-            return Roots::miss();
+            return (Roots::miss(), real);
         }
-        // 3. Half chord and both roots.
+        // 3. Half chord and both roots, for lanes inside the range.
+        let escaped = super::escaped(real, None, p.r2, p.c2);
         let d = (p.r2 - b2).sqrt();
-        Roots::in_interval(ray, v - d, v + d, real)
+        (
+            Roots::in_interval(ray, v - d, v + d, real.and_not(escaped)),
+            escaped,
+        )
     }
 }
 
@@ -81,6 +96,7 @@ impl SphereKernel for Geometric {
     const UNIT_DIRECTIONS: bool = true;
     #[inline(always)]
     fn roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Roots<L> {
-        Geometric::roots_prepared(ray, &Geometric::prepare(ray.origin, sphere))
+        let (roots, escaped) = Geometric::body(ray, &Geometric::prepare(ray.origin, sphere));
+        super::with_fallback(ray, sphere, roots, escaped)
     }
 }

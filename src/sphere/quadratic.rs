@@ -57,14 +57,18 @@ fn quadratic<L: Lane, const UNIT: bool>(ray: &RayPacket<L>, s: &SpherePacket<L>)
     let t = s.center - ray.origin;
     let mu = ray.dir.dot(t);
     // 2. The discriminant (over 4): δ = μ² − a(T·T − r²).
-    let c = t.dot(t) - s.radius * s.radius;
+    let tt = t.dot(t);
+    let r2 = s.radius * s.radius;
+    let c = tt - r2;
     let a = if UNIT {
         L::from_f32(1.0)
     } else {
         ray.dir.length_squared()
     };
     let delta = if UNIT { mu * mu - c } else { mu * mu - a * c };
-    let real = delta.ge(L::from_f32(0.0));
+    // `!(δ < 0)`: a NaN or infinite δ (squares that overflowed) goes on to the range guard
+    // (`is_finite` is a bit test, not counted).
+    let real = !delta.lt(L::from_f32(0.0)) | !delta.is_finite();
     if real.none() {
         return Roots::miss();
     }
@@ -75,7 +79,10 @@ fn quadratic<L: Lane, const UNIT: bool>(ray: &RayPacket<L>, s: &SpherePacket<L>)
     } else {
         ((mu - root) / a, (mu + root) / a)
     };
-    Roots::in_interval(ray, lo, hi, real)
+    let roots = Roots::in_interval(ray, lo, hi, real);
+    // 4. The range guard: lanes whose scale left f32's safe range, recomputed in f64.
+    let escaped = super::escaped(real, (!UNIT).then_some(a), r2, tt);
+    super::with_fallback(ray, s, roots, escaped)
 }
 
 impl SphereKernel for Quadratic {

@@ -46,16 +46,26 @@ impl SphereKernel for Robust {
         let l = f.mul_add(d, beta / a);
         let r2 = s.radius * s.radius;
         let disc = a * (r2 - l.length_squared());
-        let real = disc.ge(L::from_f32(0.0));
+        // `!(Δ < 0)`: a NaN or infinite Δ (squares that overflowed) goes on to the range
+        // guard (`is_finite` is a bit test, not counted).
+        let real = !disc.lt(L::from_f32(0.0)) | !disc.is_finite();
         if real.none() {
             return Roots::miss();
         }
         // 3. Stable roots: q never cancels; the smaller root is c/q when β ≥ 0.
-        let c = f.length_squared() - r2;
+        let ff = f.length_squared();
+        let c = ff - r2;
         let root = disc.sqrt();
         let up = beta.ge(L::from_f32(0.0));
         let q = beta + L::select(up, root, -root);
         let (ta, tb) = (c / q, q / a);
-        Roots::in_interval(ray, L::select(up, ta, tb), L::select(up, tb, ta), real)
+        let (lo, hi) = (L::select(up, ta, tb), L::select(up, tb, ta));
+        // 4. Ascending: near tangency c/q and q/a are rounded separately and may cross.
+        let swap = hi.lt(lo);
+        let (lo, hi) = (L::select(swap, hi, lo), L::select(swap, lo, hi));
+        let roots = Roots::in_interval(ray, lo, hi, real);
+        // 5. The range guard: lanes whose scale left f32's safe range, recomputed in f64.
+        let escaped = super::escaped(real, Some(a), r2, ff);
+        super::with_fallback(ray, s, roots, escaped)
     }
 }

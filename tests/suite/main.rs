@@ -8,6 +8,7 @@ mod opcount;
 mod readme;
 #[cfg(feature = "demo")]
 mod render;
+mod robust;
 mod triangles;
 #[cfg(feature = "vectors")]
 mod vectors;
