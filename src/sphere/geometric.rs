@@ -24,7 +24,12 @@ use crate::vec3::V3;
 /// ```
 ///
 /// As a [`SphereKernel`] (one ray, one sphere, nothing cached) it first prepares `T`, `c²`,
-/// `r²` (3 mul + 1 mul, 5 add): miss 8 mul, 8 add, 1 cmp.
+/// `r²` (3 mul + 1 mul, 5 add): miss 8 mul, 8 add, 1 cmp. A hit adds the 4 interval compares
+/// and the 3 of the [range guard](super#range).
+///
+/// **Range.** `r` within `2^-30…2^30` and `c ≤ 2^30` in f32 (checked on `r²` and `c²`);
+/// outside, [`SphereKernel::roots`] answers in `f64` with [`Robust`](super::Robust), while
+/// [`Geometric::roots_prepared`] (whose prepared values no longer hold the sphere) misses.
 ///
 /// **Requires unit directions.** **Limits:** `c² − v²` cancels for spheres far away relative to
 /// their radius, as in [`Quadratic`](super::Quadratic): decisions near the rim degrade from

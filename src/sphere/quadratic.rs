@@ -16,7 +16,11 @@ use crate::ray::RayPacket;
 /// ```
 ///
 /// **Operation count per lane** (measured by `examples/opcount.rs`): miss 12 mul, 11 add,
-/// 1 cmp; hit adds 1 sqrt, 2 add, 2 div and the 4 interval compares.
+/// 1 cmp; hit adds 1 sqrt, 2 add, 2 div, the 4 interval compares and the 5 compares of the
+/// [range guard](super#range) (`QuadraticUnit`: 3).
+///
+/// **Range.** `|d|`, `r` within `2^-30…2^30` and `|o − c| ≤ 2^30` in f32; lanes outside are
+/// answered by [`Robust`] in `f64` or (below `2^-62`) miss — see [the module](super#range).
 ///
 /// **Limits.** In f32 the constant term `T·T − r²` loses `2·log2(|T|/r)` bits, so spheres far
 /// away relative to their size are misclassified near their rim from about `|T|/r ≈ 2^8` on
@@ -43,7 +47,8 @@ pub struct Quadratic;
 /// t = μ ∓ √δ         2 add            (the two roots; the lecture's tally leaves these out)
 /// ```
 ///
-/// The point `P = L + tU` adds 3 mul and 3 add ([`surface`](super::surface)).
+/// The point `P = L + tU` adds 3 mul and 3 add ([`surface`](super::surface)); the hit path
+/// also runs the [range guard](super#range) (3 cmp).
 ///
 /// **Requires unit directions**: with `|d| ≠ 1` the roots are wrong (nothing is normalised).
 /// Limits and edge cases as for [`Quadratic`].

@@ -18,7 +18,14 @@ use crate::ray::RayPacket;
 /// ```
 ///
 /// **Operation count per lane**: miss 14 mul, 13 add, 1 div, 1 cmp; hit adds 3 mul, 4 add,
-/// 2 div, 1 sqrt, 1 cmp (the sign) and the 4 interval compares.
+/// 2 div, 1 sqrt, 1 cmp (the sign), 1 cmp (the order: near tangency `c/q` and `q/a` are
+/// rounded separately and used to come back up to 6 ulps out of order at `|f|/r ≥ 2^18`; a
+/// select makes them ascending), the 4 interval compares and the 5 of the
+/// [range guard](super#range).
+///
+/// **Range.** `|d|`, `r` within `2^-30…2^30` and `|f| ≤ 2^30` in f32; lanes outside are
+/// recomputed by this same body in `f64` (or, below `2^-62`, may miss) — see
+/// [the module](super#range).
 ///
 /// **Limits.** Decisions are exact up to an error of a few `2^-24·|f|` in the distance `|l|`:
 /// rays passing within about `8·2^-24·|f|` of the rim of a far sphere may be misclassified

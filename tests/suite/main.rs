@@ -13,3 +13,5 @@ mod triangles;
 #[cfg(feature = "vectors")]
 mod vectors;
 mod watertight;
+#[cfg(feature = "demo")]
+mod watertight_range;

@@ -308,15 +308,46 @@ fn exact(ray: &Ray, s: &Sphere) -> [f64; 2] {
     [t0.min(t1), t0.max(t1)]
 }
 
-fn sweep<K: SphereKernel>(bases: &[(Ray, Sphere)], worst: &mut f64, misses: &mut u32) {
-    // Unit-direction kernels keep |d| = 1.
-    let js: Vec<i32> = if K::UNIT_DIRECTIONS {
+/// What the sweep saw: the worst error outside the range (as a fraction of the tolerance),
+/// lost roots, and the cases inside and outside the range.
+#[derive(Default, Debug)]
+struct Tally {
+    worst: f64,
+    lost: u32,
+    outside: u32,
+    inside: u32,
+}
+
+/// The roots of one kernel for one ray and sphere (scalar path).
+type RootsOf = fn(&Ray, &Sphere) -> Roots<f32>;
+
+fn kernel_roots<K: SphereKernel>(ray: &Ray, s: &Sphere) -> Roots<f32> {
+    K::roots(&RayPacket::splat(ray), &SpherePacket::splat(s))
+}
+
+/// The guarded focal cache, built for the ray's origin.
+fn focal_cache_roots(ray: &Ray, s: &Sphere) -> Roots<f32> {
+    let e = FocalSphere::new(ray.origin(), s);
+    <Focal as FocalKernel>::roots(&RayPacket::splat(ray), &FocalSphere::splat(&e))
+}
+
+/// Sweeps `roots` over scaled copies of `bases`; `unit` keeps |d| = 1, and `exact` asks for
+/// bit-exact scale invariance inside the range (else only that no root is lost there).
+fn sweep(
+    name: &str,
+    roots: RootsOf,
+    unit: bool,
+    exact_scale: bool,
+    bases: &[(Ray, Sphere)],
+    tally: &mut Tally,
+) {
+    let js: Vec<i32> = if unit {
         vec![0]
     } else {
         (-140..=140).step_by(5).collect()
     };
     for (ray, s) in bases {
-        let base = K::roots(&RayPacket::<f32>::splat(ray), &SpherePacket::splat(s));
+        let base = roots(ray, s);
         let (b, bn) = base.lane(0);
         let ex = exact(ray, s);
         // The kernel's own accuracy on the base case (Quadratic loses bits to T·T − r²).
@@ -350,7 +381,7 @@ fn sweep<K: SphereKernel>(bases: &[(Ray, Sphere)], worst: &mut f64, misses: &mut
                 let scale = (k - j) as f64;
                 let sray = Ray::with_interval(o, d, ray.t_min(), ray.t_max());
                 let ss = Sphere::new(c, r);
-                let got = K::roots(&RayPacket::<f32>::splat(&sray), &SpherePacket::splat(&ss));
+                let got = roots(&sray, &ss);
                 let (g, gn) = got.lane(0);
                 let want_t = |t: f32| t as f64 * 2f64.powf(scale);
                 // Inside the documented range, with one binade of margin for the rounding of the
@@ -360,11 +391,17 @@ fn sweep<K: SphereKernel>(bases: &[(Ray, Sphere)], worst: &mut f64, misses: &mut
                 let f = len(w(o) - w(c));
                 let in_range = inside(r as f64) && inside(len(w(d))) && f <= hi;
                 if in_range {
-                    assert_eq!(gn, bn, "{} k={k} j={j} {ray:?} {s:?}", K::NAME);
+                    tally.inside += 1;
+                    assert_eq!(gn, bn, "{name} k={k} j={j} {ray:?} {s:?}");
                     for i in 0..gn {
-                        assert_eq!(g[i] as f64, want_t(b[i]), "{} k={k} j={j}", K::NAME);
+                        if exact_scale {
+                            assert_eq!(g[i] as f64, want_t(b[i]), "{name} k={k} j={j}");
+                        } else {
+                            assert!(rel(g[i], want_t(b[i])) <= tol, "{name} k={k} j={j}");
+                        }
                     }
                 } else {
+                    tally.outside += 1;
                     // A hit is a root of the exact problem; it may be missing.
                     for &t in &g[..gn] {
                         let e = ex
@@ -383,9 +420,9 @@ fn sweep<K: SphereKernel>(bases: &[(Ray, Sphere)], worst: &mut f64, misses: &mut
                         assert!(
                             e <= tol,
                             "{} k={k} j={j}: t = {t}, exact {ex:?}·2^{scale}",
-                            K::NAME
+                            name
                         );
-                        *worst = worst.max(e / tol);
+                        tally.worst = tally.worst.max(e / tol);
                     }
                     // A root lost although it is a normal f32 (the others round to 0 or inf).
                     let normal = |x: f64| (2f64.powi(-126)..=f32::MAX as f64).contains(&x.abs());
@@ -394,10 +431,17 @@ fn sweep<K: SphereKernel>(bases: &[(Ray, Sphere)], worst: &mut f64, misses: &mut
                         normal(x) && !g[..gn].iter().any(|&t| rel(t, x) <= 2.0 * tol)
                     });
                     if lost {
-                        *misses += 1;
-                        if *misses < 20 {
-                            println!("{} k={k} j={j}: {:?} of {:?}", K::NAME, &g[..gn], &b[..bn]);
-                        }
+                        tally.lost += 1;
+                        // Measured: only where squares underflow before the guard can see them
+                        // (|d| or both |o − c| and r below 2^-62).
+                        let tiny = 2f64.powi(-62);
+                        assert!(
+                            len(w(d)) < tiny || (f < tiny && (r as f64) < tiny),
+                            "{} k={k} j={j}: {:?} of {:?}",
+                            name,
+                            &g[..gn],
+                            &b[..bn]
+                        );
                     }
                 }
             }
@@ -447,10 +491,22 @@ fn bases(unit: bool) -> Vec<(Ray, Sphere)> {
 
 #[test]
 fn sphere_kernels_are_scale_exact_in_range_and_never_wrong_outside() {
-    let (mut worst, mut misses) = (0.0, 0);
-    sweep::<Robust>(&bases(false), &mut worst, &mut misses);
-    sweep::<Quadratic>(&bases(false), &mut worst, &mut misses);
-    sweep::<QuadraticUnit>(&bases(true), &mut worst, &mut misses);
-    sweep::<Geometric>(&bases(true), &mut worst, &mut misses);
-    println!("outside the range: worst t error {worst:.2} of the tolerance, {misses} clean misses");
+    let mut all = Tally::default();
+    let kernels: [(&str, RootsOf, bool, bool); 5] = [
+        ("robust", kernel_roots::<Robust>, false, true),
+        ("quadratic", kernel_roots::<Quadratic>, false, true),
+        ("quadratic-unit", kernel_roots::<QuadraticUnit>, true, true),
+        ("geometric", kernel_roots::<Geometric>, true, true),
+        // The focal thresholds carry absolute floors: not bit-exact under scaling.
+        ("focal", focal_cache_roots, true, false),
+    ];
+    for (name, f, unit, exact_scale) in kernels {
+        let mut t = Tally::default();
+        sweep(name, f, unit, exact_scale, &bases(unit), &mut t);
+        println!("{name}: {t:?}");
+        assert!(t.inside > 100 && t.outside > 100, "{name}: {t:?}");
+        all.worst = all.worst.max(t.worst);
+        all.lost += t.lost;
+    }
+    assert!(all.worst <= 1.0);
 }
