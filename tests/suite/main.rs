@@ -3,6 +3,7 @@
 
 mod bad_input;
 mod focal_precision;
+mod fuzz;
 mod lanes;
 mod opcount;
 mod readme;
