@@ -897,3 +897,47 @@ fn fuzz_every_entry_point_and_width() {
     }
     println!("fuzz: {n} cases × 3 widths, every entry point");
 }
+
+/// The two focal triangle cases of issue 10 ("Focal triangle hits outside the interval"): run
+/// through every focal triangle entry point; their interval is checked once
+/// [`CHECK_FOCAL_TRIANGLE_INTERVAL`] is flipped.
+#[test]
+fn focal_triangle_interval_cases_from_the_issue() {
+    let far = Triangle::new(
+        Vec3::new(10.0, -1.0, -1.0),
+        Vec3::new(10.0, 1.0, -1.0),
+        Vec3::new(10.0, 0.0, 1.0),
+    );
+    let near = Triangle::new(
+        Vec3::new(1e-7, -1.0, -1.0),
+        Vec3::new(1e-7, 1.0, -1.0),
+        Vec3::new(1e-7, 0.0, 1.0),
+    );
+    for (tri, d) in [(far, 1e-40f32), (near, 3e38)] {
+        let ray = Ray::new(Vec3::ZERO, Vec3::new(d, 0.0, 0.0));
+        let e = FocalTriangle::new(Vec3::ZERO, &tri);
+        let cache = [e];
+        let mut packed = [FocalTriangle::<f32x8>::gather(&[])];
+        FocalTriangle::pack(&cache, &mut packed);
+        let results = [
+            tf::intersect(&ray, &e, Cull::None),
+            tf::closest::<f32>(&RayPacket::splat(&ray), &cache, Cull::None).get(),
+            tf::closest::<f32x8>(&RayPacket::splat(&ray), &cache, Cull::None).lane(7),
+            tf::closest_soa::<f32x8>(&ray, &packed, Cull::None),
+        ];
+        for h in results.into_iter().flatten() {
+            record_ok(
+                "issue focal triangle",
+                &ray,
+                &h,
+                CHECK_FOCAL_TRIANGLE_INTERVAL,
+            );
+        }
+        // Möller and Watertight: no hit for either.
+        assert_eq!(triangle::intersect::<Moller>(&ray, &tri, Cull::None), None);
+        assert_eq!(
+            triangle::intersect::<Watertight>(&ray, &tri, Cull::None),
+            None
+        );
+    }
+}

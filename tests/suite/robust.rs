@@ -241,16 +241,21 @@ fn tiny_sphere_roots_and_normal() {
 fn near_tangent_far_roots_are_ascending_and_shapes_agree() {
     let mut rng = SmallRng::seed_from_u64(0x7a9e);
     let mut pairs = 0;
+    let mut bad = 0;
     for _ in 0..20_000 {
         let k = rng.random_range(18..=24);
-        let c = (1u64 << k) as f32;
-        let r = 1.0f32;
-        let center = Vec3::new(c, 0.0, 0.0);
-        // Aim at a point on the rim (in the plane x = c), nudged by a few ulps.
-        let phi: f32 = rng.random_range(0.0..core::f32::consts::TAU);
-        let rim = center + Vec3::new(0.0, phi.cos(), phi.sin()) * r;
-        let d = (rim - Vec3::ZERO).normalize();
-        let ray = Ray::new(Vec3::ZERO, d);
+        let c = (1u64 << k) as f32 * rng.random_range(1.0f32..2.0);
+        let r = rng.random_range(0.5f32..2.0);
+        let axis = Vec3::new(rng.random(), rng.random(), rng.random()) - 0.5;
+        let o = Vec3::new(rng.random(), rng.random(), rng.random()) - 0.5;
+        let center = o + axis.normalize() * c;
+        // Aim at the rim seen from the origin: rays within about c·2^-24 of tangency.
+        let side = axis
+            .cross(Vec3::new(rng.random(), rng.random(), rng.random()))
+            .normalize();
+        let rim = center + side * r;
+        let d = (rim - o).normalize();
+        let ray = Ray::new(o, d);
         let s = Sphere::new(center, r);
         for got in [
             roots::<Robust>(&ray, &s),
@@ -260,7 +265,7 @@ fn near_tangent_far_roots_are_ascending_and_shapes_agree() {
         ] {
             if got.len() == 2 {
                 pairs += 1;
-                assert!(got[0] <= got[1], "{got:?}");
+                bad += (got[0] > got[1]) as u32;
             }
         }
         // Both packet shapes, with decoys: the same closest hit.
@@ -271,6 +276,10 @@ fn near_tangent_far_roots_are_ascending_and_shapes_agree() {
         ];
         same_shapes::<Robust>(&ray, &spheres);
     }
+    // Without the ordering select, 431 of these 44,479 pairs (all from robust) came back out
+    // of order.
+    println!("{pairs} pairs of roots, {bad} out of order");
+    assert_eq!(bad, 0);
     assert!(pairs > 1000, "{pairs}");
 }
 
