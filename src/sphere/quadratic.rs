@@ -71,9 +71,10 @@ fn quadratic<L: Lane, const UNIT: bool>(ray: &RayPacket<L>, s: &SpherePacket<L>)
         ray.dir.length_squared()
     };
     let delta = if UNIT { mu * mu - c } else { mu * mu - a * c };
-    // `!(δ < 0)`: a NaN or infinite δ (squares that overflowed) goes on to the range guard
-    // (`is_finite` is a bit test, not counted).
-    let real = !delta.lt(L::from_f32(0.0)) | !delta.is_finite();
+    // `!(δ < 0)`: a NaN or infinite δ (squares that overflowed) goes on to the range guard,
+    // unless the sphere is invalid or padding (NaN radius), so that such lanes keep the early
+    // exit (`is_finite` is a bit test, not counted).
+    let real = (!delta.lt(L::from_f32(0.0)) | !delta.is_finite()) & s.radius.is_finite();
     if real.none() {
         return Roots::miss();
     }

@@ -54,8 +54,9 @@ impl SphereKernel for Robust {
         let r2 = s.radius * s.radius;
         let disc = a * (r2 - l.length_squared());
         // `!(Δ < 0)`: a NaN or infinite Δ (squares that overflowed) goes on to the range
-        // guard (`is_finite` is a bit test, not counted).
-        let real = !disc.lt(L::from_f32(0.0)) | !disc.is_finite();
+        // guard, unless the sphere is invalid or padding (NaN radius), so that such lanes
+        // keep the early exit (`is_finite` is a bit test, not counted).
+        let real = (!disc.lt(L::from_f32(0.0)) | !disc.is_finite()) & s.radius.is_finite();
         if real.none() {
             return Roots::miss();
         }
