@@ -30,11 +30,13 @@
 //!   `ρ`, for any `μ > 0`; both `μ = 2^-10` and `μ = 2^-4` are tested and a lane is rejected
 //!   when either rejects it. A NaN anywhere accepts (the compares are `!(|l|² > …)`).
 //!
-//! Cost per ray and mesh: 17 mul, 16 add, 1 div, 2 cmp ([`Bound::may_hit`]); with a focal
+//! Cost per ray and mesh: 17 mul, 16 add, 1 div, 4 cmp ([`Bound::may_hit`]); with a focal
 //! cache ([`Bound::focal`]) the [`FocalSphere`] test: 4 mul, 2 add, 1 cmp on a miss.
 //!
-//! **Limits.** Directions with `|d|` between about `2^-60` and `2^60` (so `d·d` neither
-//! underflows nor overflows). The pad grows with the distance to the mesh: the effective
+//! **Limits.** The bound is a test only for directions with `d·d` within `2^-100…2^100`
+//! (`|d|` within `2^-50…2^50`), where `d·d` neither underflows nor overflows; rays outside
+//! that range are never culled (two compares). An invalid bound culls nothing, both here and
+//! as a focal entry ([`Bound::focal`]). The pad grows with the distance to the mesh: the effective
 //! radius is about 0.1 % larger than `r` up to `|C − o| ≈ 60 r`, 3 % at `1000 r`, 22 % at
 //! `10⁴ r`.
 
@@ -53,6 +55,10 @@ pub const ETA: f64 = 1.0 / 65_536.0;
 /// meshes near the origin, the other far ones; the smaller bound is used).
 const MU: [f64; 2] = [1.0 / 1024.0, 1.0 / 16.0];
 
+/// The range of `d·d` where [`Bound::may_hit`] culls (`2^-100…2^100`).
+const DD_LO: f32 = f32::from_bits((127 - 100) << 23);
+const DD_HI: f32 = f32::from_bits((127 + 100) << 23);
+
 /// Rounds toward +inf.
 fn up(x: f64) -> f32 {
     let y = x as f32;
@@ -69,14 +75,16 @@ fn dist2(a: [f64; 3], b: [f64; 3]) -> f64 {
 }
 
 /// Ritter's sphere (see the [module docs](self)) of the finite points of `points`, or `None`
-/// when there is none.
+/// when there is none or when the enclosing radius exceeds `f32::MAX` (points spread over
+/// more than f32's range, e.g. `±f32::MAX`): the result is always a valid sphere.
 #[must_use]
 pub fn ritter(points: &[Vec3]) -> Option<Sphere> {
     bounding(|| points.iter().copied())
 }
 
 /// Ritter's sphere of the vertices referenced by `indices` (out-of-range indices and
-/// non-finite positions are skipped), or `None` when there is none.
+/// non-finite positions are skipped), or `None` when there is none or its radius would exceed
+/// `f32::MAX` (as [`ritter`]).
 #[must_use]
 pub fn ritter_indexed(positions: &[Vec3], indices: &[[u32; 3]]) -> Option<Sphere> {
     bounding(|| {
@@ -139,8 +147,10 @@ fn bounding<I: Iterator<Item = Vec3>>(points: impl Fn() -> I) -> Option<Sphere> 
     let (c1, r1) = enclose(c);
     let (c2, r2) = enclose(boxed);
     let (c, r) = if r2 < r1 { (c2, r2) } else { (c1, r1) };
-    // A single point still gets a positive radius.
-    Some(Sphere::new(c, r.max(f32::MIN_POSITIVE)))
+    // A radius past f32::MAX (points spread over more than f32's range) has no sphere: `None`,
+    // never a sphere with a NaN radius. A single point still gets a positive radius.
+    r.is_finite()
+        .then(|| Sphere::new(c, r.max(f32::MIN_POSITIVE)))
 }
 
 /// A bounding sphere prepared for culling (see the [module docs](self)).
@@ -190,19 +200,22 @@ impl Bound {
 
     /// False only in lanes whose ray line passes farther than `ρ = r + η(|C − o| + r)` from
     /// the centre, so that no triangle inside the sphere can report a hit: 17 mul, 16 add,
-    /// 1 div, 2 cmp.
+    /// 1 div, 4 cmp. Lanes whose `d·d` lies outside `2^-100…2^100` are never culled.
     #[inline]
     #[must_use]
     pub fn may_hit<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
         let d = rays.dir;
         // 1. Origin to centre, and the foot of the perpendicular along the ray.
         let f = V3::splat(self.sphere.center()) - rays.origin;
-        let s = f.dot(d) / d.length_squared();
+        let dd = d.length_squared();
+        let s = f.dot(d) / dd;
         // 2. The perpendicular and its square against the padded, inflated radius.
         let l2 = (f - d.scale(s)).length_squared();
         let f2 = f.length_squared();
         let limit = |k: usize| L::from_f32(self.r2[k]) + L::from_f32(self.kappa[k]) * f2;
-        !(l2.gt(limit(0)) | l2.gt(limit(1)))
+        // 3. Directions outside the range where d·d is accurate are never culled.
+        let scaled = dd.ge(L::from_f32(DD_LO)) & dd.le(L::from_f32(DD_HI));
+        !(l2.gt(limit(0)) | l2.gt(limit(1))) | !scaled
     }
 
     /// The sphere as a guarded focal cache entry for rays from `eye`, with the radius padded
@@ -210,12 +223,22 @@ impl Bound {
     /// within `2^-24|A − E|` of the true ones, and the unit direction that the sphere test
     /// uses is within `3·2^-24` of the ray's. [`FocalSphere`]'s guard then decides the line
     /// exactly, so no hit is lost.
+    ///
+    /// **An invalid bound culls nothing**, as in [`may_hit`](Self::may_hit): when the sphere is
+    /// invalid (e.g. `Sphere::new(c, -1.0)`), the eye is not finite, or the padded radius is
+    /// not representable in f32, the entry is [`FocalSphere::pass_all`], whose cheap test
+    /// accepts every ray (and which, used as a sphere, is never hit).
     #[must_use]
     pub fn focal(&self, eye: Vec3) -> FocalSphere<f32> {
         let s = &self.sphere;
         let c = libm::sqrt(dist2(wide(s.center()), wide(eye)));
         let r = s.radius() as f64;
         let rho = up((r + (ETA + 4.0 * U) * (c + r)) * (1.0 + 1.0e-9));
-        FocalSphere::new(eye, &Sphere::new(s.center(), rho))
+        let padded = Sphere::new(s.center(), rho);
+        if padded.is_valid() && eye.is_finite() {
+            FocalSphere::new(eye, &padded)
+        } else {
+            FocalSphere::pass_all()
+        }
     }
 }

@@ -73,17 +73,24 @@ impl Pinhole {
     }
 
     /// The rays of pixels `(x, y) … (x + L::LANES − 1, y)` of one image row, unit directions,
-    /// interval `(0, +inf)`. Lanes past the right edge never hit.
+    /// interval `(0, +inf)`.
+    ///
+    /// **Pixels outside the image** (`x + i ≥ width` or `y ≥ height`, including columns past
+    /// `u32::MAX`, which are counted without wrapping) get the empty interval `(+inf, −inf)`:
+    /// they never hit, whatever their direction, and never alias another pixel. No input
+    /// panics.
     #[must_use]
     pub fn row_packet<L: Lane>(&self, x: u32, y: u32) -> RayPacket<L> {
-        let px = L::from_f32_fn(|i| (x + i as u32) as f32 + 0.5);
+        // Column of lane i, in u64 so that x + i cannot wrap (x ≤ u32::MAX, i < 2^32).
+        let col = |i: usize| u64::from(x) + i as u64;
+        let px = L::from_f32_fn(|i| col(i) as f32 + 0.5);
         let py = L::from_f32((y as f32) + 0.5);
         let corner = V3::<L>::splat(self.corner);
         let target = corner + V3::splat(self.du).scale(px) + V3::splat(self.dv).scale(py);
         let d = target - V3::splat(self.eye);
         let dir = d.div_by(d.length_squared().sqrt());
         let inside = L::from_f32_fn(|i| {
-            if x + (i as u32) < self.width && y < self.height {
+            if col(i) < u64::from(self.width) && y < self.height {
                 f32::INFINITY
             } else {
                 0.0

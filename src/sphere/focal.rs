@@ -36,8 +36,14 @@
 //! **Requirements.** Rays start exactly at the eye the cache was built for and have unit
 //! directions (`||U|² − 1| ≤ 2^-20`, which any f32 `normalize` meets; [`Pinhole`] makes such
 //! rays). **Edge cases.** Invalid spheres (see [`Sphere::new`]) and a non-finite eye give
-//! `k_lo = +inf`: never hit. Coordinates beyond `2^60` or radii below `2^-40` send every ray to
-//! the `f64` path.
+//! `k_lo = +inf`: never hit.
+//!
+//! **Range.** The f32 path serves `c ≤ 10^18` and `r` within `10^-12…10^18`; every other
+//! sphere sends all its rays to the `f64` path (no ray is a certain miss there, even when `l²`
+//! overflows f32), so every finite input gets a correct answer: measured over positions
+//! scaled by `2^-140…2^140` (`tests/suite/robust.rs`), no root lost and none wrong.
+//! [`FocalUnguarded`] answers only `c ≤ 2^30`, `r` within `2^-30…2^30` and never hits
+//! other spheres (a documented clean miss).
 //!
 //! [`Robust`]: super::Robust
 //! [`Pinhole`]: crate::camera::Pinhole
@@ -45,7 +51,7 @@
 
 use glam::Vec3;
 
-use super::{Robust, Roots, Sphere, SphereKernel, SpherePacket};
+use super::{Roots, Sphere, SpherePacket};
 use crate::hit::{self, HitRecord};
 use crate::lane::{Lane, Mask};
 use crate::ray::{Ray, RayPacket};
@@ -151,15 +157,20 @@ impl FocalSphere<f32> {
             );
         }
         if !guarded {
-            return entry(k as f32, f32::NEG_INFINITY, f32::INFINITY, f32::INFINITY);
+            // Outside c ≤ 2^30, 2^-30 ≤ r ≤ 2^30 the f32 squares lose their range: never hit.
+            let range = (1.0 / 1_073_741_824.0)..=1_073_741_824.0;
+            let fits = c2 <= sq(*range.end()) && range.contains(&r);
+            let k_lo = if fits { k as f32 } else { f32::INFINITY };
+            return entry(k_lo, f32::NEG_INFINITY, f32::INFINITY, f32::INFINITY);
         }
         let c = libm::sqrt(c2);
         if !(c <= 1.0e18 && (1.0e-12..=1.0e18).contains(&r)) {
-            // Squares would leave f32's range: every ray takes the f64 path.
+            // Squares would leave f32's range: every ray takes the f64 path (`l2_miss = NaN`
+            // so that no lane is a certain miss, not even one whose `l²` overflowed).
             return entry(
                 f32::NEG_INFINITY,
                 f32::NEG_INFINITY,
-                f32::INFINITY,
+                f32::NAN,
                 f32::INFINITY,
             );
         }
@@ -210,6 +221,21 @@ impl FocalSphere<f32> {
             l2_miss,
             t_acc,
         )
+    }
+}
+
+impl FocalSphere<f32> {
+    /// An entry whose cheap test passes every ray (`k_lo = −inf`) and which is never hit
+    /// (its sphere is invalid, so the `f64` path misses): what [`Bound::focal`] returns for
+    /// an invalid bound, which must cull nothing.
+    ///
+    /// [`Bound::focal`]: crate::bounds::Bound::focal
+    #[must_use]
+    pub fn pass_all() -> Self {
+        FocalSphere {
+            k_lo: f32::NEG_INFINITY,
+            ..Self::new(Vec3::ZERO, &Sphere::new(Vec3::ZERO, f32::NAN))
+        }
     }
 }
 
@@ -444,27 +470,8 @@ fn hit_path<L: Lane, S: FocalLanes<L>>(
     if doubtful.none() {
         roots
     } else {
-        precise(*ray, s.sphere(), roots, doubtful)
+        super::precise(*ray, s.sphere(), roots, doubtful)
     }
-}
-
-/// Recomputes the `doubtful` lanes with [`Robust`] in `L::Precise` (`f64`). Out of line and
-/// taking its inputs by value, so the callers' ray packets never need an address.
-#[inline(never)]
-fn precise<L: Lane>(
-    ray: RayPacket<L>,
-    s: SpherePacket<L>,
-    mut roots: Roots<L>,
-    doubtful: L::Mask,
-) -> Roots<L> {
-    let mut bits = doubtful.bits();
-    while bits != 0 {
-        let i = bits.trailing_zeros() as usize;
-        let p = Robust::roots(&ray.precise_lane(i), &s.precise_lane(i));
-        roots = roots.with_precise_lane(i, ray.t_min.lane(i), ray.t_max.lane(i), &p);
-        bits &= bits - 1;
-    }
-    roots
 }
 
 /// Closest hit of ray packets from the cache's eye over cached spheres (N rays × 1 sphere).

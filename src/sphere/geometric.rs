@@ -24,7 +24,12 @@ use crate::vec3::V3;
 /// ```
 ///
 /// As a [`SphereKernel`] (one ray, one sphere, nothing cached) it first prepares `T`, `c²`,
-/// `r²` (3 mul + 1 mul, 5 add): miss 8 mul, 8 add, 1 cmp.
+/// `r²` (3 mul + 1 mul, 5 add): miss 8 mul, 8 add, 1 cmp. A hit adds the 4 interval compares
+/// and the 3 of the [range guard](super#range).
+///
+/// **Range.** `r` within `2^-30…2^30` and `c ≤ 2^30` in f32 (checked on `r²` and `c²`);
+/// outside, [`SphereKernel::roots`] answers in `f64` with [`Robust`](super::Robust), while
+/// [`Geometric::roots_prepared`] (whose prepared values no longer hold the sphere) misses.
 ///
 /// **Requires unit directions.** **Limits:** `c² − v²` cancels for spheres far away relative to
 /// their radius, as in [`Quadratic`](super::Quadratic): decisions near the rim degrade from
@@ -58,21 +63,36 @@ impl Geometric {
         }
     }
 
-    /// The per-ray test with prepared values: the lecture's 4 mul, 3 add on a miss.
+    /// The per-ray test with prepared values: the lecture's 4 mul, 3 add on a miss. Lanes
+    /// outside the range (see [`Geometric`]) are a miss here: prepared values no longer hold
+    /// the sphere for the `f64` fallback that [`SphereKernel::roots`] runs.
     #[inline(always)]
     #[must_use]
     pub fn roots_prepared<L: Lane>(ray: &RayPacket<L>, p: &Prepared<L>) -> Roots<L> {
+        let (roots, _) = Self::body(ray, p);
+        roots
+    }
+
+    /// The body: the roots of lanes in range, and the lanes the range guard sent away.
+    #[inline(always)]
+    fn body<L: Lane>(ray: &RayPacket<L>, p: &Prepared<L>) -> (Roots<L>, L::Mask) {
         // 1. Foot of the perpendicular along the ray.
         let v = p.t.dot(ray.dir);
         // 2. Squared distance from the centre to the ray, against r².
         let b2 = p.c2 - v * v;
-        let real = p.r2.ge(b2);
+        // `!(r² < b²)`: a NaN or infinite b² (squares that overflowed) goes on to the range
+        // guard (`is_finite` is a bit test, not counted).
+        let real = !p.r2.lt(b2) | !b2.is_finite();
         if real.none() {
-            return Roots::miss();
+            return (Roots::miss(), real);
         }
-        // 3. Half chord and both roots.
+        // 3. Half chord and both roots, for lanes inside the range.
+        let escaped = super::escaped(real, None, p.r2, p.c2);
         let d = (p.r2 - b2).sqrt();
-        Roots::in_interval(ray, v - d, v + d, real)
+        (
+            Roots::in_interval(ray, v - d, v + d, real.and_not(escaped)),
+            escaped,
+        )
     }
 }
 
@@ -81,6 +101,7 @@ impl SphereKernel for Geometric {
     const UNIT_DIRECTIONS: bool = true;
     #[inline(always)]
     fn roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Roots<L> {
-        Geometric::roots_prepared(ray, &Geometric::prepare(ray.origin, sphere))
+        let (roots, escaped) = Geometric::body(ray, &Geometric::prepare(ray.origin, sphere));
+        super::with_fallback(ray, sphere, roots, escaped)
     }
 }

@@ -16,7 +16,11 @@ use crate::ray::RayPacket;
 /// ```
 ///
 /// **Operation count per lane** (measured by `examples/opcount.rs`): miss 12 mul, 11 add,
-/// 1 cmp; hit adds 1 sqrt, 2 add, 2 div and the 4 interval compares.
+/// 1 cmp; hit adds 1 sqrt, 2 add, 2 div, the 4 interval compares and the 5 compares of the
+/// [range guard](super#range) (`QuadraticUnit`: 3).
+///
+/// **Range.** `|d|`, `r` within `2^-30…2^30` and `|o − c| ≤ 2^30` in f32; lanes outside are
+/// answered by [`Robust`] in `f64` or (below `2^-62`) miss — see [the module](super#range).
 ///
 /// **Limits.** In f32 the constant term `T·T − r²` loses `2·log2(|T|/r)` bits, so spheres far
 /// away relative to their size are misclassified near their rim from about `|T|/r ≈ 2^8` on
@@ -43,7 +47,8 @@ pub struct Quadratic;
 /// t = μ ∓ √δ         2 add            (the two roots; the lecture's tally leaves these out)
 /// ```
 ///
-/// The point `P = L + tU` adds 3 mul and 3 add ([`surface`](super::surface)).
+/// The point `P = L + tU` adds 3 mul and 3 add ([`surface`](super::surface)); the hit path
+/// also runs the [range guard](super#range) (3 cmp).
 ///
 /// **Requires unit directions**: with `|d| ≠ 1` the roots are wrong (nothing is normalised).
 /// Limits and edge cases as for [`Quadratic`].
@@ -57,14 +62,19 @@ fn quadratic<L: Lane, const UNIT: bool>(ray: &RayPacket<L>, s: &SpherePacket<L>)
     let t = s.center - ray.origin;
     let mu = ray.dir.dot(t);
     // 2. The discriminant (over 4): δ = μ² − a(T·T − r²).
-    let c = t.dot(t) - s.radius * s.radius;
+    let tt = t.dot(t);
+    let r2 = s.radius * s.radius;
+    let c = tt - r2;
     let a = if UNIT {
         L::from_f32(1.0)
     } else {
         ray.dir.length_squared()
     };
     let delta = if UNIT { mu * mu - c } else { mu * mu - a * c };
-    let real = delta.ge(L::from_f32(0.0));
+    // `!(δ < 0)`: a NaN or infinite δ (squares that overflowed) goes on to the range guard,
+    // unless the sphere is invalid or padding (NaN radius), so that such lanes keep the early
+    // exit (`is_finite` is a bit test, not counted).
+    let real = (!delta.lt(L::from_f32(0.0)) | !delta.is_finite()) & s.radius.is_finite();
     if real.none() {
         return Roots::miss();
     }
@@ -75,7 +85,10 @@ fn quadratic<L: Lane, const UNIT: bool>(ray: &RayPacket<L>, s: &SpherePacket<L>)
     } else {
         ((mu - root) / a, (mu + root) / a)
     };
-    Roots::in_interval(ray, lo, hi, real)
+    let roots = Roots::in_interval(ray, lo, hi, real);
+    // 4. The range guard: lanes whose scale left f32's safe range, recomputed in f64.
+    let escaped = super::escaped(real, (!UNIT).then_some(a), r2, tt);
+    super::with_fallback(ray, s, roots, escaped)
 }
 
 impl SphereKernel for Quadratic {

@@ -18,7 +18,14 @@ use crate::ray::RayPacket;
 /// ```
 ///
 /// **Operation count per lane**: miss 14 mul, 13 add, 1 div, 1 cmp; hit adds 3 mul, 4 add,
-/// 2 div, 1 sqrt, 1 cmp (the sign) and the 4 interval compares.
+/// 2 div, 1 sqrt, 1 cmp (the sign), 1 cmp (the order: near tangency `c/q` and `q/a` are
+/// rounded separately and used to come back up to 6 ulps out of order at `|f|/r ≥ 2^18`; a
+/// select makes them ascending), the 4 interval compares and the 5 of the
+/// [range guard](super#range).
+///
+/// **Range.** `|d|`, `r` within `2^-30…2^30` and `|f| ≤ 2^30` in f32; lanes outside are
+/// recomputed by this same body in `f64` (or, below `2^-62`, may miss) — see
+/// [the module](super#range).
 ///
 /// **Limits.** Decisions are exact up to an error of a few `2^-24·|f|` in the distance `|l|`:
 /// rays passing within about `8·2^-24·|f|` of the rim of a far sphere may be misclassified
@@ -46,16 +53,27 @@ impl SphereKernel for Robust {
         let l = f.mul_add(d, beta / a);
         let r2 = s.radius * s.radius;
         let disc = a * (r2 - l.length_squared());
-        let real = disc.ge(L::from_f32(0.0));
+        // `!(Δ < 0)`: a NaN or infinite Δ (squares that overflowed) goes on to the range
+        // guard, unless the sphere is invalid or padding (NaN radius), so that such lanes
+        // keep the early exit (`is_finite` is a bit test, not counted).
+        let real = (!disc.lt(L::from_f32(0.0)) | !disc.is_finite()) & s.radius.is_finite();
         if real.none() {
             return Roots::miss();
         }
         // 3. Stable roots: q never cancels; the smaller root is c/q when β ≥ 0.
-        let c = f.length_squared() - r2;
+        let ff = f.length_squared();
+        let c = ff - r2;
         let root = disc.sqrt();
         let up = beta.ge(L::from_f32(0.0));
         let q = beta + L::select(up, root, -root);
         let (ta, tb) = (c / q, q / a);
-        Roots::in_interval(ray, L::select(up, ta, tb), L::select(up, tb, ta), real)
+        let (lo, hi) = (L::select(up, ta, tb), L::select(up, tb, ta));
+        // 4. Ascending: near tangency c/q and q/a are rounded separately and may cross.
+        let swap = hi.lt(lo);
+        let (lo, hi) = (L::select(swap, hi, lo), L::select(swap, lo, hi));
+        let roots = Roots::in_interval(ray, lo, hi, real);
+        // 5. The range guard: lanes whose scale left f32's safe range, recomputed in f64.
+        let escaped = super::escaped(real, Some(a), r2, ff);
+        super::with_fallback(ray, s, roots, escaped)
     }
 }

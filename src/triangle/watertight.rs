@@ -36,6 +36,10 @@ use crate::vec3::V3;
 /// **Edge cases.** `det = 0` (a ray parallel to the triangle, or a degenerate projection) is a
 /// miss; NaN fails the compares; a zero direction never reaches the kernel (rays are
 /// sanitised).
+///
+/// **Range.** Watertight for meshes of size `2^-40…2^30` (`U`, `V`, `W` and `T` are products
+/// of two and three coordinates: beyond that range they under- or overflow and rays leak);
+/// tested at both ends by `tests/suite/watertight_range.rs`.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Watertight;
 

@@ -9,14 +9,18 @@ mod exact_ref;
 mod focal_accuracy;
 mod focal_precision;
 mod focal_rules;
+mod fuzz;
 mod lanes;
 mod opcount;
 mod readme;
 #[cfg(feature = "demo")]
 mod render;
+mod robust;
 #[cfg(feature = "vectors")]
 mod study;
 mod triangles;
 #[cfg(feature = "vectors")]
 mod vectors;
 mod watertight;
+#[cfg(feature = "demo")]
+mod watertight_range;

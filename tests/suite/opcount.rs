@@ -23,7 +23,9 @@ fn brute_force_quadratic_matches_the_lecture() {
     let miss = get("quadratic-unit", "miss");
     let hit = get("quadratic-unit", "hit");
     assert_eq!(miss, c(8, 9, 0, 0, 1));
-    assert_eq!(hit, c(8, 11, 0, 1, 5));
+    // The hit adds the two roots' interval compares (4) and the range guard (3: r² in
+    // [2^-60, 2^60], T·T ≤ 2^60), which sends lanes outside f32's safe range to f64.
+    assert_eq!(hit, c(8, 11, 0, 1, 1 + 4 + 3));
     assert_eq!((hit.mul, hit.add - 2, hit.sqrt), (8, 9, 1));
     // "The point adds 3 multiplies and 3 additions."
     assert_eq!(get("sphere-point", "hit"), c(3, 3, 0, 0, 0));
@@ -33,8 +35,9 @@ fn brute_force_quadratic_matches_the_lecture() {
 fn geometric_miss_is_v_plus_the_test() {
     // v = T·U: 3 mul, 2 add; the test r² ≥ c² − v²: 1 mul, 1 sub, 1 compare.
     assert_eq!(get("geometric-prepared", "miss"), c(3 + 1, 2 + 1, 0, 0, 1));
-    // The hit adds the half chord (1 sub, 1 sqrt) and the two roots v ∓ d (2 add).
-    assert_eq!(get("geometric-prepared", "hit"), c(4, 6, 0, 1, 5));
+    // The hit adds the half chord (1 sub, 1 sqrt), the two roots v ∓ d (2 add), their
+    // interval compares (4) and the range guard (3 cmp).
+    assert_eq!(get("geometric-prepared", "hit"), c(4, 6, 0, 1, 1 + 4 + 3));
     // Unprepared, T = C − E (3 add), c² (3 mul, 2 add) and r² (1 mul) come first.
     assert_eq!(get("geometric", "miss"), c(8, 8, 0, 0, 1));
 }
@@ -55,12 +58,19 @@ fn focal_miss_within_four_mul_two_add() {
 fn every_other_count_is_pinned() {
     let want = [
         ("quadratic", "miss", c(12, 11, 0, 0, 1)),
-        ("quadratic", "hit", c(12, 13, 2, 1, 5)),
-        ("geometric", "hit", c(8, 11, 0, 1, 5)),
+        // Hits: + 4 interval compares + the range guard (5 cmp with a = d·d, 3 without).
+        ("quadratic", "hit", c(12, 13, 2, 1, 1 + 4 + 5)),
+        ("geometric", "hit", c(8, 11, 0, 1, 1 + 4 + 3)),
         ("robust", "miss", c(14, 13, 1, 0, 1)),
-        ("robust", "hit", c(17, 17, 3, 1, 6)),
-        ("focal", "doubtful", c(27, 27, 3, 2, 15)),
-        ("sphere-surface", "hit", c(9, 10, 3, 1, 0)),
+        // The sign, 4 interval compares, the ascending order (1) and the range guard (5).
+        ("robust", "hit", c(17, 17, 3, 1, 1 + 1 + 4 + 1 + 5)),
+        // The f64 Robust of a doubtful lane includes its order compare (no range guard).
+        ("focal", "doubtful", c(27, 27, 3, 2, 16)),
+        // The normal's range check (2 cmp) sends points within 2^-50 or beyond 2^50 of the
+        // centre to f64.
+        ("sphere-surface", "hit", c(9, 10, 3, 1, 2)),
+        // The line test (2 cmp) and the direction range (2 cmp).
+        ("bound", "per mesh", c(17, 16, 1, 0, 4)),
         ("plane", "miss", c(6, 7, 1, 0, 2)),
         ("plane", "hit", c(6, 7, 1, 0, 2)),
         ("plane-focal", "miss", c(3, 2, 1, 0, 2)),
