@@ -172,9 +172,11 @@ pub fn sign_triple(d: [f64; 3], a: [f64; 3], b: [f64; 3]) -> i32 {
 
 /// Component `(j, k)` of `(p − e) × (q − e)` for `f32` vectors, exactly: the six products
 /// `p_j q_k − p_j e_k − e_j q_k − p_k q_j + p_k e_j + e_k q_j` (the `e_j e_k` terms cancel).
-/// With `e = a`, `p = b`, `q = c` it is the plane normal `(b − a) × (c − a)`.
+/// With `e = a`, `p = b`, `q = c` it is the plane normal `(b − a) × (c − a)`. The axes `j`,
+/// `k` are taken modulo 3 (so no index can panic).
 #[must_use]
 pub fn cross_rel(e: [f64; 3], p: [f64; 3], q: [f64; 3], j: usize, k: usize) -> Expansion {
+    let (j, k) = (j % 3, k % 3);
     // (Six components at most; `round_f32` adds one more.)
     let mut x = Expansion::new();
     for t in [
