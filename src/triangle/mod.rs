@@ -35,7 +35,8 @@
 //! [`Watertight`] is measured watertight there (both ends tested by
 //! `tests/suite/watertight_range.rs`; the accuracy tables are measured at ordinary scale).
 //! Outside that range the products round to zero, subnormals or infinity and rays may leak
-//! through edges or miss (a clean miss: `t = +inf`), but the answers stay consistent: each
+//! through edges or miss (a clean miss: `t = +inf`; the deferred-division kernels miss
+//! wherever `|det| < 2^-100`), but the answers stay consistent: each
 //! ray–triangle answer depends on that ray and triangle only, the test before the division is
 //! conservative at every magnitude (above), so N rays × 1 triangle and 1 ray × N triangles
 //! return the same closest hit bit for bit, every lane equals the scalar path, and every
@@ -308,7 +309,11 @@ pub trait TriangleKernel {
 ///    closer triangle that 1 ray × N triangles found), so such lanes skip the pre-test and are
 ///    decided on their rounded `t` alone. Exact either way: `fl(t_max·den) < 2^-126` implies
 ///    `t_max·den < 2^-126`, and the pre-test only ever rejects lanes whose `t` fails step 3.
-/// 3. `t = num_t/den` (1 div), strictly inside `(t_min, t_max)` — 2 cmp. `u`, `v` stay
+/// 3. `t = num_t/den` (1 div), strictly inside `(t_min, t_max)`, and `den ≥ 2^-100` — 3 cmp.
+///    Below `2^-100` the products that make `det` and the numerators have under-flowed
+///    (`det` is a product of three coordinates: a mesh of size `2^-53` seen with directions of
+///    length `2^-53` gave `t = 1`, `u = 1` or `t = 0` far outside the mesh's bound), so such a
+///    lane is a clean miss, the same in every packet shape. `u`, `v` stay
 ///    unscaled with `den`: the loops divide them once per ray, for the winner.
 #[inline(always)]
 pub(crate) fn resolve<L: Lane>(
@@ -333,6 +338,9 @@ pub(crate) fn in_front<L: Lane>(ray: &RayPacket<L>, mask: L::Mask, num_t: L) -> 
     mask & (num_t.gt(zero) | ray.t_min.lt(zero))
 }
 
+/// The smallest `|det|` a deferred-division kernel reports a hit for, `2^-100` (see [`resolve`]).
+const MIN_DET: f32 = 1.0 / (1u128 << 100) as f32;
+
 /// Steps 2 and 3 of [`resolve`], with `t = num_t/den` and the barycentrics deferred as
 /// `num_u/w`, `num_v/w` (the focal kernel divides `t` and `u`, `v` by different
 /// denominators; the others pass `w = den`).
@@ -353,7 +361,14 @@ pub(crate) fn within<L: Lane>(
         return LaneHit::miss();
     }
     let t = num_t / den;
-    let mask = mask & t.gt(ray.t_min) & t.lt(ray.t_max) & num_u.is_finite() & num_v.is_finite();
+    // Below `2^-100` the products that make `det` and the numerators have under-flowed: a
+    // clean miss rather than a `t`, `u`, `v` made of rounding errors.
+    let mask = mask
+        & t.gt(ray.t_min)
+        & t.lt(ray.t_max)
+        & den.ge(L::from_f32(MIN_DET))
+        & num_u.is_finite()
+        & num_v.is_finite();
     LaneHit::deferred(t, num_u, num_v, w, mask)
 }
 

@@ -859,7 +859,9 @@ fn run_case(case_seed: u64) -> (Case, std::thread::Result<()>) {
 /// products (`src/triangle/mod.rs`, `within`): a hit at `t ≈ 2^-45…2^-49`, or at `t = 0` with
 /// `t_min < 0`, where `t_max·det` is subnormal, so N rays × 1 triangle (`t_max` shrunk by an
 /// earlier hit) dropped a closer triangle that 1 ray × N triangles found: three Watertight
-/// meshes, one Watertight slice, one focal slice.
+/// meshes, one Watertight slice, one focal slice. And three found with other seeds before
+/// `|det| < 2^-100` became a clean miss: meshes of size `2^-53` (and `2^-75`) whose products
+/// under-flowed, hit at `t = 1, u = 1` or `t = 0` outside their Ritter bound.
 #[test]
 fn fuzz_triangle_range_regressions() {
     for seed in [
@@ -868,6 +870,9 @@ fn fuzz_triangle_range_regressions() {
         0x9e4b_417e_b533_a204,
         0x985e_a72e_e987_448d,
         0xab0c_61af_de6e_b89f,
+        0x983b_d7b5_6b8a_c1e8,
+        0xfcbb_30fe_57de_15f6,
+        0xb9b6_c8d9_f91b_99d5,
     ] {
         let (_, run) = run_case(seed);
         if let Err(e) = run {
