@@ -83,7 +83,7 @@
 //!
 //! **Operation count per lane** (measured by `examples/opcount.rs`): miss 9 mul, 6 add,
 //! 6 cmp; edges passed but the triangle behind the eye 9 mul, 6 add, 8 cmp; a hit with `t`,
-//! `u`, `v` 13 mul, 10 add, 1 div, 13 cmp (`u`, `v`: 2 div once per ray, for the winner). Per
+//! `u`, `v` 13 mul, 10 add, 1 div, 15 cmp (`u`, `v`: 2 div once per ray, for the winner). Per
 //! ray and query ([`FocalRays::new`]): 3 mul and 2 cmp for the scaling, 6 mul, 2 add, 1 div,
 //! 1 sqrt for the unit direction that bounding spheres use, and 1 mul, 1 add to scale `t`
 //! back (the add turns `−0` into `+0`); the power of two and the interval are found per lane

@@ -29,7 +29,7 @@ use crate::vec3::V3;
 /// **Claimed count.** not quoted: the paper's text was not available to this study (only its
 /// formulation, from secondary sources), so its own tally, if any, is not checked here.
 /// **Measured** per lane (pinned in `tests/suite/opcount.rs`): miss 20 mul, 16 add, 5 cmp; hit
-/// 21 mul, 16 add, 1 div, 10 cmp; behind the origin 20 mul, 16 add, 7 cmp; precomputation 36
+/// 21 mul, 16 add, 1 div, 12 cmp; behind the origin 20 mul, 16 add, 7 cmp; precomputation 36
 /// mul, 23 add, 1 div. **Record:** 48 bytes.
 ///
 /// **Limits.** Not watertight; the scaled planes are rounded once per triangle, and `U`, `V`

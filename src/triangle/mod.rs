@@ -19,14 +19,30 @@
 //! with `N = (B − A) × (C − A)`, i.e. A, B, C counter-clockwise as seen from the ray origin.
 //! Directions need not be unit length; `t` is in units of `|d|`.
 //!
-//! **Deferred division.** [`Moller`], [`Watertight`] and [`focal`] test the edges against the
-//! unscaled determinant, `t > 0` as the sign of its numerator and `t < t_max` as
-//! `num_t < t_max·|det|`; only lanes that pass divide, `t = num_t/|det|`, and a hit needs the
-//! rounded `t` strictly inside `(t_min, t_max)`. In a closest-hit loop that is only the hits
-//! that win so far: the loops relax `t_max` after each hit so that the rounded product never
-//! drops a winner, and take a candidate only when its rounded `t` is below the best, so every
-//! traversal order and both packet shapes find the same closest hit, bit for bit (see
-//! [`crate::hit`]). `u`, `v` are divided once per ray, for the winner.
+//! **Deferred division.** [`Moller`], [`Watertight`], [`Plucker`], [`HavelHerout`] and
+//! [`focal`] test the edges against the unscaled determinant, `t > 0` as the sign of its
+//! numerator and `t < t_max` as `num_t < t_max·|det|` (skipped where that product is
+//! subnormal, so it cannot drop a hit at any magnitude); only lanes that pass divide,
+//! `t = num_t/|det|`, and a hit needs the rounded `t` strictly inside `(t_min, t_max)`. In a
+//! closest-hit loop that is only the hits that win so far: the loops relax `t_max` after each
+//! hit so that the rounded product never drops a winner, and take a candidate only when its
+//! rounded `t` is below the best, so every traversal order and both packet shapes find the
+//! same closest hit, bit for bit (see [`crate::hit`]). `u`, `v` are divided once per ray, for
+//! the winner.
+//!
+//! **Range.** The edge functions, `det` and `num_t` are products of two and three
+//! coordinates: for meshes of size `2^-40…2^30` they neither under- nor overflow, and
+//! [`Watertight`] is measured watertight there (both ends tested by
+//! `tests/suite/watertight_range.rs`; the accuracy tables are measured at ordinary scale).
+//! Outside that range the products round to zero, subnormals or infinity and rays may leak
+//! through edges or miss (a clean miss: `t = +inf`; the deferred-division kernels miss
+//! wherever `|det| < 2^-100`), but the answers stay consistent: each
+//! ray–triangle answer depends on that ray and triangle only, the test before the division is
+//! conservative at every magnitude (above), so N rays × 1 triangle and 1 ray × N triangles
+//! return the same closest hit bit for bit, every lane equals the scalar path, and every
+//! record is finite and strictly inside its interval. The seeded fuzzer
+//! (`tests/suite/fuzz.rs`: magnitudes `2^-140…2^127`, special values) checks this on every
+//! case, its former failures kept as regression cases.
 //!
 //! **Entry points.** [`intersect`] (one ray, one triangle), [`closest`], [`any`], [`all`] (ray
 //! packets over a slice of triangles: N rays × 1 triangle) and [`closest_soa`], [`any_soa`]
@@ -283,11 +299,21 @@ pub trait TriangleKernel {
 ///
 /// 1. The lower end on the unscaled value: `num_t > 0` (exact in sign) unless `t_min < 0` —
 ///    2 cmp; a triangle behind the origin costs no division.
-/// 2. The upper end before dividing: `num_t < t_max·den` — 1 mul, 1 cmp. The product rounds,
-///    but the closest-hit loops relax `t_max` to `t + |t|·2^-21` after each hit and take a
-///    candidate only when its rounded `t` is below the best (see [`crate::hit`]), so
-///    this never drops a hit that would win: only the hits that win so far reach step 3.
-/// 3. `t = num_t/den` (1 div), strictly inside `(t_min, t_max)` — 2 cmp. `u`, `v` stay
+/// 2. The upper end before dividing: `num_t < t_max·den`, or `t_max·den` below the smallest
+///    normal `2^-126` — 1 mul, 2 cmp. The product rounds, but the closest-hit loops relax
+///    `t_max` to `t + |t|·2^-21` after each hit and take a candidate only when its rounded `t`
+///    is below the best (see [`crate::hit`]), so this never drops a hit that would win: only
+///    the hits that win so far reach step 3. That holds while the product is normal (relative
+///    error `2^-24` < the relaxation's `2^-21`); a subnormal product has an absolute error that
+///    no relative margin covers (tiny `t`, tiny `det`: N rays × 1 triangle then missed a
+///    closer triangle that 1 ray × N triangles found), so such lanes skip the pre-test and are
+///    decided on their rounded `t` alone. Exact either way: `fl(t_max·den) < 2^-126` implies
+///    `t_max·den < 2^-126`, and the pre-test only ever rejects lanes whose `t` fails step 3.
+/// 3. `t = num_t/den` (1 div), strictly inside `(t_min, t_max)`, and `den ≥ 2^-100` — 3 cmp.
+///    Below `2^-100` the products that make `det` and the numerators have under-flowed
+///    (`det` is a product of three coordinates: a mesh of size `2^-53` seen with directions of
+///    length `2^-53` gave `t = 1`, `u = 1` or `t = 0` far outside the mesh's bound), so such a
+///    lane is a clean miss, the same in every packet shape. `u`, `v` stay
 ///    unscaled with `den`: the loops divide them once per ray, for the winner.
 #[inline(always)]
 pub(crate) fn resolve<L: Lane>(
@@ -312,6 +338,9 @@ pub(crate) fn in_front<L: Lane>(ray: &RayPacket<L>, mask: L::Mask, num_t: L) -> 
     mask & (num_t.gt(zero) | ray.t_min.lt(zero))
 }
 
+/// The smallest `|det|` a deferred-division kernel reports a hit for, `2^-100` (see [`resolve`]).
+const MIN_DET: f32 = 1.0 / (1u128 << 100) as f32;
+
 /// Steps 2 and 3 of [`resolve`], with `t = num_t/den` and the barycentrics deferred as
 /// `num_u/w`, `num_v/w` (the focal kernel divides `t` and `u`, `v` by different
 /// denominators; the others pass `w = den`).
@@ -325,12 +354,21 @@ pub(crate) fn within<L: Lane>(
     num_v: L,
     w: L,
 ) -> LaneHit<L> {
-    let mask = mask & num_t.lt(ray.t_max * den);
+    let bound = ray.t_max * den;
+    // A subnormal product carries an absolute rounding error: decide those lanes on `t`.
+    let mask = mask & (num_t.lt(bound) | bound.lt(L::from_f32(f32::MIN_POSITIVE)));
     if mask.none() {
         return LaneHit::miss();
     }
     let t = num_t / den;
-    let mask = mask & t.gt(ray.t_min) & t.lt(ray.t_max) & num_u.is_finite() & num_v.is_finite();
+    // Below `2^-100` the products that make `det` and the numerators have under-flowed: a
+    // clean miss rather than a `t`, `u`, `v` made of rounding errors.
+    let mask = mask
+        & t.gt(ray.t_min)
+        & t.lt(ray.t_max)
+        & den.ge(L::from_f32(MIN_DET))
+        & num_u.is_finite()
+        & num_v.is_finite();
     LaneHit::deferred(t, num_u, num_v, w, mask)
 }
 

@@ -24,7 +24,7 @@ use crate::ray::RayPacket;
 ///
 /// **Operation count per lane** (measured by `examples/opcount.rs`): miss 21 mul, 22 add,
 /// 5 cmp; a triangle behind the origin 24 mul, 24 add (no division); hit 25 mul, 24 add,
-/// 1 div, 10 cmp.
+/// 1 div, 12 cmp.
 ///
 /// **Limits.** Not watertight: the edge values of two triangles sharing an edge are computed
 /// from different origins (`s = o − A` differs), so a ray through the edge can slip between

@@ -39,7 +39,7 @@ use crate::ray::RayPacket;
 /// 10,950 rays of `tests/suite/watertight.rs`; with `ε` the counts are in the study table.
 ///
 /// **Claimed count.** Embree's source states none (read for this study); measured here per lane (pinned in
-/// `tests/suite/opcount.rs`): miss 28 mul, 44 add, 6 cmp; hit 41 mul, 53 add, 1 div, 18 cmp.
+/// `tests/suite/opcount.rs`): miss 28 mul, 44 add, 6 cmp; hit 41 mul, 53 add, 1 div, 20 cmp.
 ///
 /// **Edge cases.** `den = 0` or `U + V + W = 0` is a miss; NaN fails every compare.
 #[derive(Clone, Copy, Debug, Default)]

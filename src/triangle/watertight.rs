@@ -31,7 +31,7 @@ use crate::vec3::V3;
 ///
 /// **Operation count per lane** (measured by `examples/opcount.rs`): per ray 3 div, 4 cmp
 /// ([`Shear::new`]); per triangle a miss 12 mul, 18 add, 6 cmp; a hit 19 mul, 22 add, 1 div,
-/// 12 cmp; a lane with an exactly zero edge function adds 6 mul and 3 add in `f64`.
+/// 15 cmp; a lane with an exactly zero edge function adds 6 mul and 3 add in `f64`.
 ///
 /// **Edge cases.** `det = 0` (a ray parallel to the triangle, or a degenerate projection) is a
 /// miss; NaN fails the compares; a zero direction never reaches the kernel (rays are

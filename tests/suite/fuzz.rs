@@ -46,16 +46,6 @@ use wide::{f32x4, f32x8, f32x16};
 /// `d = 3e38`, fixed by mapping the interval into the scaled units exactly).
 const CHECK_FOCAL_TRIANGLE_INTERVAL: bool = true;
 
-/// The triangle kernels (`src/triangle`, shared loops in `src/hit.rs`) have no range guard
-/// yet: outside the watertight range (`2^-40…2^30`) their products under- or overflow, so
-/// `T < t_max·|det|` (the test before the division) can make N rays × 1 triangle miss a
-/// closer triangle that 1 ray × N triangles finds, and `t = T/det` can be wrong (a hit
-/// outside the mesh's bounding sphere, which culling then removes). Until they get one,
-/// packet-shape agreement and "culling loses no hit" are checked for triangles and meshes
-/// only on ordinary cases (magnitude `2^-30…2^20`, no special values); everything else (no
-/// panic, lanes equal scalar, finite records, hits inside the interval) on every case.
-const CHECK_TRIANGLES_OUT_OF_RANGE: bool = false;
-
 /// Rays per case: one packet of the widest width.
 const RAYS: usize = 16;
 
@@ -175,7 +165,7 @@ impl Gen {
         if unit {
             d = d.normalize_or_zero();
         } else if self.spoil > 0.0 && self.rng.random_bool(0.2) {
-            // Directions far from the positions' scale (not in ordinary cases).
+            // Directions far from the positions' scale (in cases with special values).
             d *= 2f32.powi(self.rng.random_range(-100..100));
         }
         let (lo, hi) = match self.rng.random_range(0..10) {
@@ -202,8 +192,6 @@ struct Case {
     tris: Vec<Triangle>,
     positions: Vec<Vec3>,
     indices: Vec<[u32; 3]>,
-    /// Magnitude within `2^-30…2^20`, no special values, directions at the positions' scale.
-    ordinary: bool,
 }
 
 fn case(rng: &mut SmallRng) -> Case {
@@ -300,7 +288,6 @@ fn case(rng: &mut SmallRng) -> Case {
         tris,
         positions,
         indices,
-        ordinary: spoil == 0.0 && (2f32.powi(-30)..=2f32.powi(20)).contains(&scale),
     }
 }
 
@@ -562,13 +549,11 @@ fn triangle_kernel<K: TriangleKernel, L: Lane<Scalar = f32>>(c: &Case, cull: Cul
             record_ok(name, ray, &r, true);
         }
         same(name, any.test(i), o.is_some());
-        if c.ordinary || CHECK_TRIANGLES_OUT_OF_RANGE {
-            same(
-                name,
-                bits(triangle::closest_soa::<K, L>(ray, &packed[..n], cull)),
-                bits(o),
-            );
-        }
+        same(
+            name,
+            bits(triangle::closest_soa::<K, L>(ray, &packed[..n], cull)),
+            bits(o),
+        );
         same(
             name,
             triangle::any_soa::<K, L>(ray, &packed[..n], cull),
@@ -616,13 +601,11 @@ fn focal_triangles<L: Lane<Scalar = f32>>(c: &Case, cull: Cull) {
             record_ok("triangle-focal", ray, &r, check);
         }
         same("triangle-focal any", any.test(i), o.is_some());
-        if c.ordinary || CHECK_TRIANGLES_OUT_OF_RANGE {
-            same(
-                "triangle-focal closest_soa",
-                bits(tf::closest_soa::<L>(ray, &packed[..n], cull)),
-                bits(o),
-            );
-        }
+        same(
+            "triangle-focal closest_soa",
+            bits(tf::closest_soa::<L>(ray, &packed[..n], cull)),
+            bits(o),
+        );
         same(
             "triangle-focal any_soa",
             tf::any_soa::<L>(ray, &packed[..n], cull),
@@ -671,11 +654,9 @@ fn meshes<K: TriangleKernel, L: Lane<Scalar = f32>>(c: &Case, cull: Cull) {
                 record_ok(name, ray, &r, true);
             }
             same(name, any.test(i), o.is_some());
-            if c.ordinary || CHECK_TRIANGLES_OUT_OF_RANGE {
-                same(name, bits(m.closest_soa::<K, L>(ray, cull)), bits(o));
-            }
+            same(name, bits(m.closest_soa::<K, L>(ray, cull)), bits(o));
             same(name, m.any_soa::<K, L>(ray, cull), o.is_some());
-            if exact && (c.ordinary || CHECK_TRIANGLES_OUT_OF_RANGE) {
+            if exact {
                 // The Ritter bound contains every vertex: culling never loses a hit.
                 let p = plain.closest::<K, f32>(&RayPacket::splat(ray), cull).get();
                 assert_eq!(bits(o), bits(p), "ritter culling: {ray:?}, {:?}", m.bound());
@@ -726,9 +707,7 @@ fn focal_meshes<L: Lane<Scalar = f32>>(c: &Case, cull: Cull) {
             let u = unbounded
                 .closest(&FocalRays::new(&RayPacket::<f32>::splat(ray)), cull)
                 .get();
-            if c.ordinary || CHECK_TRIANGLES_OUT_OF_RANGE {
-                same("focal mesh culling", bits(o), bits(u));
-            }
+            same("focal mesh culling", bits(o), bits(u));
         }
         fm.all(&fr, cull, |_, h| {
             for (i, ray) in rays.iter().enumerate() {
@@ -876,6 +855,45 @@ fn width<L: Lane<Scalar = f32>>(c: &Case, rng: &mut SmallRng) {
     bounds_and_camera::<L>(c, rng);
 }
 
+/// Case `case_seed` at every width (f32x4, f32x8, f32x16): the case and whether it passed.
+fn run_case(case_seed: u64) -> (Case, std::thread::Result<()>) {
+    let mut r = SmallRng::seed_from_u64(case_seed);
+    let c = case(&mut r);
+    let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+        width::<f32x4>(&c, &mut r);
+        width::<f32x8>(&c, &mut r);
+        width::<f32x16>(&c, &mut r);
+    }));
+    (c, run)
+}
+
+/// The cases the fuzzer found before the test ahead of the deferred division skipped subnormal
+/// products (`src/triangle/mod.rs`, `within`): a hit at `t ≈ 2^-45…2^-49`, or at `t = 0` with
+/// `t_min < 0`, where `t_max·det` is subnormal, so N rays × 1 triangle (`t_max` shrunk by an
+/// earlier hit) dropped a closer triangle that 1 ray × N triangles found: three Watertight
+/// meshes, one Watertight slice, one focal slice. And three found with other seeds before
+/// `|det| < 2^-100` became a clean miss: meshes of size `2^-53` (and `2^-75`) whose products
+/// under-flowed, hit at `t = 1, u = 1` or `t = 0` outside their Ritter bound.
+#[test]
+fn fuzz_triangle_range_regressions() {
+    for seed in [
+        0x9809_d5ed_9b3f_2b21,
+        0xbd40_debc_ef7a_1fa7,
+        0x9e4b_417e_b533_a204,
+        0x985e_a72e_e987_448d,
+        0xab0c_61af_de6e_b89f,
+        0x983b_d7b5_6b8a_c1e8,
+        0xfcbb_30fe_57de_15f6,
+        0xb9b6_c8d9_f91b_99d5,
+    ] {
+        let (_, run) = run_case(seed);
+        if let Err(e) = run {
+            eprintln!("fuzz regression {seed:#x} failed");
+            std::panic::resume_unwind(e);
+        }
+    }
+}
+
 #[test]
 fn fuzz_every_entry_point_and_width() {
     let n = cases();
@@ -889,13 +907,7 @@ fn fuzz_every_entry_point_and_width() {
         if replay.is_some() && k > 0 {
             break;
         }
-        let mut r = SmallRng::seed_from_u64(case_seed);
-        let c = case(&mut r);
-        let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
-            width::<f32x4>(&c, &mut r);
-            width::<f32x8>(&c, &mut r);
-            width::<f32x16>(&c, &mut r);
-        }));
+        let (c, run) = run_case(case_seed);
         if let Err(e) = run {
             if replay.is_some() {
                 eprintln!("{c:#?}");
