@@ -149,18 +149,11 @@ pub fn entries() -> [Entry; 18] {
     let none = OpCounts::default();
     let vertices = 3 * size_of::<Vec3>();
     let ball = 4 * size_of::<f32>();
-    let plain_entry = |method, source, c: [OpCounts; 3]| Entry {
-        method,
-        shape: Shape::Triangle,
-        source,
-        miss: c[0],
-        hit: c[1],
-        behind: Some(c[2]),
-        per_ray: none,
-        bytes: vertices,
-        pre: Precompute::None,
-    };
-    let pre_entry = |method, source, (c, pre): ([OpCounts; 3], OpCounts), bytes| Entry {
+    let tri = |method: &'static str,
+               source: &'static str,
+               c: [OpCounts; 3],
+               bytes: usize,
+               pre: Precompute| Entry {
         method,
         shape: Shape::Triangle,
         source,
@@ -169,30 +162,37 @@ pub fn entries() -> [Entry; 18] {
         behind: Some(c[2]),
         per_ray: none,
         bytes,
-        pre: Precompute::Counted(pre),
+        pre,
     };
-    let sphere_own = |method, kernel: &'static str, source, bytes, pre| Entry {
+    let plain_entry = |method, source, c| tri(method, source, c, vertices, Precompute::None);
+    let pre_entry = |method, source, (c, pre): ([OpCounts; 3], OpCounts), bytes| {
+        tri(method, source, c, bytes, Precompute::Counted(pre))
+    };
+    let sphere = |method: &'static str,
+                  source: &'static str,
+                  c: [OpCounts; 2],
+                  bytes: usize,
+                  pre: Precompute| Entry {
         method,
         shape: Shape::Sphere,
         source,
-        miss: row(kernel, "miss"),
-        hit: row(kernel, "hit"),
+        miss: c[0],
+        hit: c[1],
         behind: None,
         per_ray: none,
         bytes,
         pre,
     };
-    let sphere_new = |method, source, c: [OpCounts; 2]| Entry {
-        method,
-        shape: Shape::Sphere,
-        source,
-        miss: c[0],
-        hit: c[1],
-        behind: None,
-        per_ray: none,
-        bytes: ball,
-        pre: Precompute::None,
+    let sphere_own = |method, kernel: &'static str, source, bytes, pre| {
+        sphere(
+            method,
+            source,
+            [row(kernel, "miss"), row(kernel, "hit")],
+            bytes,
+            pre,
+        )
     };
+    let sphere_new = |method, source, c| sphere(method, source, c, ball, Precompute::None);
     let focal_tri = Entry {
         method: "focal",
         shape: Shape::Triangle,
