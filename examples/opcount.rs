@@ -25,11 +25,12 @@ mod watertight;
 #[path = "../tests/suite/study.rs"]
 mod study;
 
-/// Every study method on both paths, each one out-of-line call of
-/// `raylane::study::repeat` over 64 tests and one over none, in 8 lanes, each call announced by
-/// a `cfg SHAPE METHOD PATH LANES TESTS` line (under callgrind, dump k is call k).
+/// Every study method on both paths (and its precomputation, if any), each one out-of-line
+/// call of `raylane::study::repeat` over 64 iterations and one over none, in 8 lanes, each
+/// call announced by a `cfg SHAPE METHOD PATH UNITS N` line (`UNITS` tests or builds per
+/// iteration; under callgrind, dump k is call k).
 fn measure() {
-    use raylane::study::{self, METHODS, Path, Shape};
+    use raylane::study::{self, METHODS, PATHS, Path, Shape};
     use std::io::Write;
     let mut out = std::io::stdout().lock();
     for (i, (shape, method)) in METHODS.iter().enumerate() {
@@ -37,16 +38,21 @@ fn measure() {
             Shape::Triangle => "triangle",
             Shape::Sphere => "sphere",
         };
-        for (path, name) in [(Path::Miss, "miss"), (Path::Hit, "hit")] {
+        for (path, name) in PATHS {
+            if path == Path::Precompute && !study::precomputes(i) {
+                continue;
+            }
+            let units = study::units::<wide::f32x8>(i, path);
             for n in [64, 0] {
-                writeln!(out, "cfg {shape} {method} {name} 8 {n}").expect("stdout");
+                writeln!(out, "cfg {shape} {method} {name} {units} {n}").expect("stdout");
                 out.flush().expect("stdout");
-                let hits = study::repeat::<wide::f32x8>(
+                let done = study::repeat::<wide::f32x8>(
                     std::hint::black_box(i),
                     std::hint::black_box(path),
                     std::hint::black_box(n),
                 );
-                assert_eq!(hits, Some(if path == Path::Hit { 8 * n as u32 } else { 0 }));
+                let miss = path == Path::Miss;
+                assert_eq!(done, Some(if miss { 0 } else { (units * n) as u32 }));
             }
         }
     }

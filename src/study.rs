@@ -90,11 +90,23 @@ pub struct Measured {
     pub accuracy: [Option<(f64, u32)>; 6],
     /// `(rays, leaks, double hits)` on the closed meshes; `None` for spheres.
     pub watertight: Option<(usize, usize, usize)>,
-    /// Executed instructions per ray–primitive test on x86-64-v3 (8 lanes), `[miss, hit]`,
-    /// as measured by `scripts/count-study.sh` ([`repeat`]); `None` if not measured.
-    pub x86: Option<[f64; 2]>,
+    /// Executed instructions on x86-64-v3 (8 lanes), as measured by `scripts/count-study.sh`
+    /// ([`repeat`]); `None` if not measured.
+    pub x86: Option<Insns>,
     /// The same on a Cortex-M4F (scalar lane, QEMU's TCG plugin).
-    pub m4f: Option<[f64; 2]>,
+    pub m4f: Option<Insns>,
+}
+
+/// Executed instructions of a method on one target (see [`repeat`]).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Insns {
+    /// Per ray–primitive test on the miss.
+    pub miss: f64,
+    /// Per test on the hit.
+    pub hit: f64,
+    /// Per record built (per primitive), or per focal cache built (per primitive and eye);
+    /// `None` without a precomputation.
+    pub precompute: Option<f64>,
 }
 
 fn row(kernel: &str, path: &str) -> OpCounts {
@@ -346,7 +358,7 @@ pub fn write_table(
 ) -> fmt::Result {
     writeln!(
         f,
-        "| method | source | miss | hit | behind | per ray | bytes | precompute | x86-64-v3 insns miss / hit | M4F insns miss / hit | largest t error per class | leaks | double hits |"
+        "| method | source | miss | hit | behind | per ray | bytes | precompute | x86-64-v3 insns: miss / hit / precompute | M4F insns: miss / hit / precompute | largest t error per class | leaks | double hits |"
     )?;
     writeln!(
         f,
@@ -375,7 +387,13 @@ pub fn write_table(
         }
         for insns in [m.x86, m.m4f] {
             match insns {
-                Some([miss, hit]) => write!(f, " | {miss:.1} / {hit:.1}")?,
+                Some(i) => {
+                    write!(f, " | {:.1} / {:.1} / ", i.miss, i.hit)?;
+                    match i.precompute {
+                        Some(p) => write!(f, "{p:.0}")?,
+                        None => f.write_str("–")?,
+                    }
+                }
                 None => f.write_str(" | –")?,
             }
         }
@@ -425,6 +443,34 @@ pub enum Path {
     Miss,
     /// The hit.
     Hit,
+    /// The precomputation instead of the test: the record of [`PrecomputedKernel::precompute`]
+    /// (one per lane) or the focal cache (`FocalTriangle::new`, `FocalSphere::new`: one per
+    /// call, for the hit's eye), for the methods that have one ([`precomputes`]).
+    Precompute,
+}
+
+/// The paths with their names in `docs/study-insns.txt`, in the order they are measured.
+pub const PATHS: [(Path, &str); 3] = [
+    (Path::Miss, "miss"),
+    (Path::Hit, "hit"),
+    (Path::Precompute, "precompute"),
+];
+
+/// Whether method `index` of [`METHODS`] has a precomputation (a record per primitive or a
+/// cache per primitive and eye).
+#[must_use]
+pub const fn precomputes(index: usize) -> bool {
+    matches!(index, 3 | 4 | 6 | 7 | 9 | 16 | 17)
+}
+
+/// What one iteration of [`repeat`]'s loop does in lanes `L`: `L::LANES` ray–primitive tests
+/// or records, or one focal cache (built per primitive, not per lane).
+#[must_use]
+pub fn units<L: Lane>(index: usize, path: Path) -> usize {
+    match (path, index) {
+        (Path::Precompute, 3 | 16 | 17) => 1,
+        _ => L::LANES,
+    }
 }
 
 /// `n` tests of one ray packet against one primitive that the compiler must reload from memory
@@ -444,7 +490,9 @@ fn tests<P, R>(n: usize, prim: &P, test: impl Fn(&P) -> R, hits: impl Fn(&R) -> 
 /// Runs the test of method `index` of [`METHODS`] `n` times on the worked example `path`, in
 /// lanes `L` (every lane the same ray and primitive), with the per-ray setup and the
 /// precomputation (records, focal caches) done once before the loop. Returns the lane hits
-/// (`n · L::LANES` on [`Path::Hit`], 0 on a miss), or `None` past the last method.
+/// (`n · L::LANES` on [`Path::Hit`], 0 on a miss; on [`Path::Precompute`], `n ·`
+/// [`units`] records or caches built, 0 for a method without any), or `None` past the last
+/// method.
 ///
 /// This is the unit the study's instruction counts are measured on (`scripts/count-study.sh`):
 /// the instructions executed inside one call with `n = 64`, minus those of a call with
@@ -453,6 +501,13 @@ fn tests<P, R>(n: usize, prim: &P, test: impl Fn(&P) -> R, hits: impl Fn(&R) -> 
 #[inline(never)]
 pub fn repeat<L: Lane<Scalar = f32>>(index: usize, path: Path, n: usize) -> Option<u32> {
     let (shape, _) = *METHODS.get(index)?;
+    if path == Path::Precompute {
+        return Some(if precomputes(index) {
+            build::<L>(index, n)
+        } else {
+            0
+        });
+    }
     let hit = path == Path::Hit;
     Some(match shape {
         Shape::Triangle => {
@@ -541,4 +596,25 @@ pub fn repeat<L: Lane<Scalar = f32>>(index: usize, path: Path, n: usize) -> Opti
             }
         }
     })
+}
+
+/// [`repeat`] on [`Path::Precompute`]: `n` records or caches of the worked primitive, each
+/// from a primitive the compiler must reload; returns how many were built.
+fn build<L: Lane<Scalar = f32>>(index: usize, n: usize) -> u32 {
+    fn record<K: PrecomputedKernel, L: Lane<Scalar = f32>>(n: usize) -> u32 {
+        let tp = TrianglePacket::<L>::splat(&triangle());
+        tests(n, &tp, |t| K::precompute(t), |_| L::LANES as u32)
+    }
+    let eye = triangle_rays()[1].origin();
+    let sphere_eye = sphere_rays().1.origin();
+    match index {
+        3 => tests(n, &triangle(), |t| FocalTriangle::new(eye, t), |_| 1),
+        4 => record::<Badouel, L>(n),
+        6 => record::<Wald, L>(n),
+        7 => record::<HavelHerout, L>(n),
+        9 => record::<BaldwinWeber, L>(n),
+        16 => tests(n, &ball(), |b| FocalSphere::new(sphere_eye, b), |_| 1),
+        17 => tests(n, &ball(), |b| FocalSphere::unguarded(sphere_eye, b), |_| 1),
+        _ => 0,
+    }
 }

@@ -4,7 +4,7 @@
 //! of the watertight harness. `examples/opcount.rs` includes this file to print the table;
 //! the test pins the README's copy.
 
-use raylane::study::{self, Entry, Measured, Shape};
+use raylane::study::{self, Entry, Insns, Measured, Shape};
 use raylane::vectors::accuracy::{self, CLASSES};
 use raylane::vectors::{Case, Kind, Method, Outcome};
 
@@ -40,7 +40,7 @@ fn insns() -> Vec<(String, String, String, String, f64)> {
 /// The table, measured now.
 pub fn report() -> String {
     let insns = insns();
-    let lookup = |target: &str, e: &Entry| -> Option<[f64; 2]> {
+    let lookup = |target: &str, e: &Entry| -> Option<Insns> {
         let shape = match e.shape {
             Shape::Triangle => "triangle",
             Shape::Sphere => "sphere",
@@ -51,7 +51,11 @@ pub fn report() -> String {
                 .find(|r| r.0 == target && r.1 == shape && r.2 == e.method && r.3 == path)
                 .map(|r| r.4)
         };
-        Some([get("miss")?, get("hit")?])
+        Some(Insns {
+            miss: get("miss")?,
+            hit: get("hit")?,
+            precompute: get("precompute"),
+        })
     };
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/vectors");
     let texts: Vec<String> = CLASSES
@@ -128,11 +132,24 @@ fn the_timed_methods_are_the_entries() {
 
 #[test]
 fn the_timed_loops_hit_and_miss_as_announced() {
-    use raylane::study::{METHODS, Path, repeat};
+    use raylane::study::{METHODS, Path, Precompute, entries, precomputes, repeat, units};
+    use wide::f32x8;
+    let entries = entries();
     for (i, m) in METHODS.iter().enumerate() {
         assert_eq!(repeat::<f32>(i, Path::Miss, 3), Some(0), "{m:?}");
         assert_eq!(repeat::<f32>(i, Path::Hit, 3), Some(3), "{m:?}");
-        assert_eq!(repeat::<wide::f32x8>(i, Path::Hit, 2), Some(16), "{m:?}");
+        assert_eq!(repeat::<f32x8>(i, Path::Hit, 2), Some(16), "{m:?}");
+        assert_eq!(precomputes(i), entries[i].pre != Precompute::None, "{m:?}");
+        let built = if precomputes(i) {
+            2 * units::<f32x8>(i, Path::Precompute)
+        } else {
+            0
+        };
+        assert_eq!(
+            repeat::<f32x8>(i, Path::Precompute, 2),
+            Some(built as u32),
+            "{m:?}"
+        );
     }
     assert_eq!(repeat::<f32>(METHODS.len(), Path::Hit, 1), None);
 }
@@ -141,19 +158,20 @@ fn the_timed_loops_hit_and_miss_as_announced() {
 fn every_method_has_its_instruction_counts() {
     let insns = insns();
     for target in ["x86-64-v3", "cortex-m4f"] {
-        for (shape, method) in study::METHODS {
+        for (i, (shape, method)) in study::METHODS.into_iter().enumerate() {
             let shape = match shape {
                 Shape::Triangle => "triangle",
                 Shape::Sphere => "sphere",
             };
-            for path in ["miss", "hit"] {
+            for (path, name) in study::PATHS {
                 let n = insns
                     .iter()
-                    .filter(|r| r.0 == target && r.1 == shape && r.2 == method && r.3 == path)
+                    .filter(|r| r.0 == target && r.1 == shape && r.2 == method && r.3 == name)
                     .count();
+                let want = usize::from(path != study::Path::Precompute || study::precomputes(i));
                 assert_eq!(
-                    n, 1,
-                    "{target} {shape} {method} {path} in docs/study-insns.txt"
+                    n, want,
+                    "{target} {shape} {method} {name} in docs/study-insns.txt"
                 );
             }
         }

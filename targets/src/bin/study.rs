@@ -3,15 +3,15 @@
 //! `scripts/count-study.sh` (it builds this, runs it on mps2-an386 and stores the counts).
 //!
 //! Each method's timed loop ([`raylane::study::repeat`], scalar `f32` lanes) runs between
-//! [`study_begin`] and [`study_end`] once over 64 tests and once over none, on the miss and on
-//! the hit; the plugin prints one window per run. Output (semihosting): one
-//! `cfg SHAPE METHOD PATH 1 TESTS` line per window, in window order.
+//! [`study_begin`] and [`study_end`] once over 64 iterations and once over none, on the miss,
+//! on the hit and on the precomputation (if any); the plugin prints one window per run.
+//! Output (semihosting): one `cfg SHAPE METHOD PATH UNITS N` line per window, in window order.
 #![no_std]
 #![no_main]
 
 use core::hint::black_box;
 
-use raylane::study::{METHODS, Path, Shape, repeat};
+use raylane::study::{METHODS, PATHS, Path, Shape, precomputes, repeat, units};
 use raylane_fw::semihosting::hprintln;
 use raylane_fw::{entry, exit};
 
@@ -47,13 +47,18 @@ fn main() -> ! {
             Shape::Triangle => "triangle",
             Shape::Sphere => "sphere",
         };
-        for (path, name) in [(Path::Miss, "miss"), (Path::Hit, "hit")] {
+        for (path, name) in PATHS {
+            if path == Path::Precompute && !precomputes(i) {
+                continue;
+            }
+            let units = units::<f32>(i, path);
             for n in [64usize, 0] {
-                hprintln!("cfg {} {} {} 1 {}", shape, method, name, n);
+                hprintln!("cfg {} {} {} {} {}", shape, method, name, units, n);
                 study_begin();
-                let hits = repeat::<f32>(black_box(i), black_box(path), black_box(n));
+                let done = repeat::<f32>(black_box(i), black_box(path), black_box(n));
                 study_end();
-                ok &= hits == Some(if path == Path::Hit { n as u32 } else { 0 });
+                let miss = path == Path::Miss;
+                ok &= done == Some(if miss { 0 } else { (units * n) as u32 });
             }
         }
     }
