@@ -37,7 +37,7 @@ fn main() -> ExitCode {
     let mut args = std::env::args().skip(1);
     while let Some(a) = args.next() {
         match a.as_str() {
-            "--method" => match args.next().as_deref().and_then(Method::parse) {
+            "--method" => match args.next().as_deref().and_then(Method::from_name) {
                 Some(m) => method = Some(m),
                 None => return usage(),
             },
