@@ -350,38 +350,62 @@ impl Kernel {
 
 // The table: one row per kernel, grouped by the checker's method. Columns: the kernel's enum
 // variant and name, whether it needs unit directions, its error model, and its call (family
-// and type). Adding a kernel is adding a row here.
+// and type). Adding a kernel is adding a row here. Each row's docs quote its pinned miss and
+// hit counts per lane (`opcount::table`, on the lectures' worked examples; the precomputed
+// methods precompute on the fly there) as `ops` markers, which `tests/suite/doc_counts.rs`
+// checks against the table.
 registry! {
     /// [`Quadratic`](crate::sphere::Quadratic): the general quadratic.
     Quadratic "quadratic" {
         /// [`sphere::Quadratic`](crate::sphere::Quadratic).
+        ///
+        /// Per lane: `ops quadratic/miss: 12 mul, 11 add, 1 cmp`;
+        /// `ops quadratic/hit: 12 mul, 13 add, 2 div, 1 sqrt, 10 cmp`.
         Quadratic "quadratic", unit: false, error: Textbook, sphere(crate::sphere::Quadratic);
     }
     /// [`QuadraticUnit`](crate::sphere::QuadraticUnit): the quadratic with `a = 1`.
     QuadraticUnit "quadratic-unit" {
         /// [`sphere::QuadraticUnit`](crate::sphere::QuadraticUnit).
+        ///
+        /// Per lane: `ops quadratic-unit/miss: 8 mul, 9 add, 1 cmp`;
+        /// `ops quadratic-unit/hit: 8 mul, 11 add, 1 sqrt, 8 cmp`.
         QuadraticUnit "quadratic-unit", unit: true, error: Textbook,
             sphere(crate::sphere::QuadraticUnit);
     }
     /// [`Geometric`](crate::sphere::Geometric): the lecture's geometric test.
     Geometric "geometric" {
         /// [`sphere::Geometric`](crate::sphere::Geometric).
+        ///
+        /// Per lane: `ops geometric/miss: 8 mul, 8 add, 1 cmp`;
+        /// `ops geometric/hit: 8 mul, 11 add, 1 sqrt, 8 cmp`.
         Geometric "geometric", unit: true, error: Textbook, sphere(crate::sphere::Geometric);
     }
     /// [`Robust`](crate::sphere::Robust): Ray Tracing Gems ch. 7.
     Robust "robust" {
         /// [`sphere::Robust`](crate::sphere::Robust).
+        ///
+        /// Per lane: `ops robust/miss: 14 mul, 13 add, 1 div, 1 cmp`;
+        /// `ops robust/hit: 17 mul, 17 add, 3 div, 1 sqrt, 12 cmp`.
         Robust "robust", unit: false, error: RobustSphere, sphere(crate::sphere::Robust);
     }
     /// The focal caches of spheres (guarded), planes and triangles; per vector case the eye is
     /// the ray origin.
     Focal "focal" {
         /// [`sphere::focal::Focal`](crate::sphere::focal::Focal) over guarded caches.
+        ///
+        /// Per lane: `ops focal/miss: 4 mul, 2 add, 1 cmp`;
+        /// `ops focal/hit: 10 mul, 10 add, 1 sqrt, 9 cmp`.
         Focal "focal", unit: true, error: Exact,
             focal_sphere(crate::sphere::focal::Focal, true);
         /// [`FocalPlane`](crate::plane::FocalPlane) caches.
+        ///
+        /// Per lane: `ops plane-focal/miss: 3 mul, 2 add, 1 div, 2 cmp`;
+        /// `ops plane-focal/hit: 3 mul, 2 add, 1 div, 2 cmp`.
         PlaneFocal "plane-focal", unit: false, error: Exact, focal_plane;
         /// [`FocalTriangle`](crate::triangle::FocalTriangle) caches.
+        ///
+        /// Per lane: `ops triangle-focal/miss: 9 mul, 6 add, 6 cmp`;
+        /// `ops triangle-focal/hit: 13 mul, 10 add, 1 div, 15 cmp`.
         TriangleFocal "triangle-focal", unit: false, error: Exact, focal_triangle;
     }
     /// [`FocalUnguarded`](crate::sphere::focal::FocalUnguarded): the lecture's unguarded focal
@@ -389,65 +413,101 @@ registry! {
     FocalUnguarded "focal-unguarded" {
         /// [`sphere::focal::FocalUnguarded`](crate::sphere::focal::FocalUnguarded) over
         /// unguarded caches.
+        ///
+        /// Per lane: `ops focal-unguarded/miss: 4 mul, 2 add, 1 cmp`;
+        /// `ops focal-unguarded/hit: 4 mul, 5 add, 1 sqrt, 5 cmp`.
         FocalUnguarded "focal-unguarded", unit: true, error: Textbook,
             focal_sphere(crate::sphere::focal::FocalUnguarded, false);
     }
     /// The ray–plane test.
     Plane "plane" {
         /// [`plane::intersect_lanes`](crate::plane::intersect_lanes).
+        ///
+        /// Per lane: `ops plane/miss: 6 mul, 7 add, 1 div, 2 cmp`;
+        /// `ops plane/hit: 6 mul, 7 add, 1 div, 2 cmp`.
         Plane "plane", unit: false, error: Exact, plane;
     }
     /// [`Cramer`](crate::triangle::Cramer): lecture 002.
     Cramer "cramer" {
         /// [`triangle::Cramer`](crate::triangle::Cramer).
+        ///
+        /// Per lane: `ops cramer/miss: 21 mul, 22 add, 2 div, 5 cmp`;
+        /// `ops cramer/hit: 30 mul, 27 add, 3 div, 7 cmp`.
         Cramer "cramer", unit: false, error: Needle, triangle(crate::triangle::Cramer);
     }
     /// [`Moller`](crate::triangle::Moller): Möller–Trumbore, division deferred.
     Moller "moller" {
         /// [`triangle::Moller`](crate::triangle::Moller).
+        ///
+        /// Per lane: `ops moller/miss: 21 mul, 22 add, 5 cmp`;
+        /// `ops moller/hit: 25 mul, 24 add, 1 div, 12 cmp`.
         Moller "moller", unit: false, error: Needle, triangle(crate::triangle::Moller);
     }
     /// [`Watertight`](crate::triangle::Watertight): Woop, Benthin, Wald 2013.
     Watertight "watertight" {
         /// [`triangle::Watertight`](crate::triangle::Watertight).
+        ///
+        /// Per lane: `ops watertight/miss: 12 mul, 18 add, 6 cmp`;
+        /// `ops watertight/hit: 19 mul, 22 add, 1 div, 15 cmp`.
         Watertight "watertight", unit: false, error: Exact, triangle(crate::triangle::Watertight);
     }
     /// [`Pbrt`](crate::sphere::Pbrt): pbrt-v4's sphere test, without intervals.
     Pbrt "pbrt" {
         /// [`sphere::Pbrt`](crate::sphere::Pbrt).
+        ///
+        /// Per lane: `ops pbrt/miss: 21 mul, 17 add, 1 div, 1 sqrt, 1 cmp`;
+        /// `ops pbrt/hit: 22 mul, 18 add, 3 div, 2 sqrt, 7 cmp`.
         Pbrt "pbrt", unit: false, error: RobustSphere, sphere(crate::sphere::Pbrt);
     }
     /// [`EmbreeSphere`](crate::sphere::EmbreeSphere): Embree's sphere test.
     EmbreeSphere "embree" {
         /// [`sphere::EmbreeSphere`](crate::sphere::EmbreeSphere).
+        ///
+        /// Per lane: `ops embree/miss: 14 mul, 12 add, 1 div, 1 cmp`;
+        /// `ops embree/hit: 15 mul, 15 add, 1 div, 1 sqrt, 5 cmp`.
         EmbreeSphere "embree", unit: false, error: RobustSphere,
             sphere(crate::sphere::EmbreeSphere);
     }
     /// [`Badouel`](crate::triangle::Badouel): Badouel 1990, plane then a 2-D test.
     Badouel "badouel" {
         /// [`triangle::Badouel`](crate::triangle::Badouel).
+        ///
+        /// Per lane: `ops badouel/miss: 23 mul, 28 add, 3 div, 9 cmp`;
+        /// `ops badouel/hit: 23 mul, 28 add, 3 div, 9 cmp`.
         Badouel "badouel", unit: false, error: Record, precomputed(crate::triangle::Badouel);
     }
     /// [`Plucker`](crate::triangle::Plucker): Plücker edge tests (Segura–Feito 1998, as in
     /// Embree).
     Plucker "plucker" {
         /// [`triangle::Plucker`](crate::triangle::Plucker).
+        ///
+        /// Per lane: `ops plucker/miss: 28 mul, 44 add, 6 cmp`;
+        /// `ops plucker/hit: 41 mul, 53 add, 1 div, 20 cmp`.
         Plucker "plucker", unit: false, error: Needle, triangle(crate::triangle::Plucker);
     }
     /// [`Wald`](crate::triangle::Wald): Wald 2004, precomputed projection.
     Wald "wald" {
         /// [`triangle::Wald`](crate::triangle::Wald).
+        ///
+        /// Per lane: `ops wald/miss: 31 mul, 25 add, 2 div, 9 cmp`;
+        /// `ops wald/hit: 31 mul, 25 add, 2 div, 9 cmp`.
         Wald "wald", unit: false, error: Record, precomputed(crate::triangle::Wald);
     }
     /// [`HavelHerout`](crate::triangle::HavelHerout): Havel–Herout 2010, precomputed planes.
     HavelHerout "havel-herout" {
         /// [`triangle::HavelHerout`](crate::triangle::HavelHerout).
+        ///
+        /// Per lane: `ops havel-herout/miss: 56 mul, 39 add, 1 div, 5 cmp`;
+        /// `ops havel-herout/hit: 57 mul, 39 add, 2 div, 12 cmp`.
         HavelHerout "havel-herout", unit: false, error: Record,
             precomputed(crate::triangle::HavelHerout);
     }
     /// [`KenslerShirley`](crate::triangle::KenslerShirley): Kensler–Shirley 2006.
     KenslerShirley "kensler-shirley" {
         /// [`triangle::KenslerShirley`](crate::triangle::KenslerShirley).
+        ///
+        /// Per lane: `ops kensler-shirley/miss: 23 mul, 22 add, 1 div, 3 cmp`;
+        /// `ops kensler-shirley/hit: 27 mul, 24 add, 1 div, 5 cmp`.
         KenslerShirley "kensler-shirley", unit: false, error: Needle,
             triangle(crate::triangle::KenslerShirley);
     }
@@ -455,6 +515,9 @@ registry! {
     /// transform.
     BaldwinWeber "baldwin-weber" {
         /// [`triangle::BaldwinWeber`](crate::triangle::BaldwinWeber).
+        ///
+        /// Per lane: `ops baldwin-weber/miss: 37 mul, 30 add, 2 div, 8 cmp`;
+        /// `ops baldwin-weber/hit: 37 mul, 30 add, 2 div, 8 cmp`.
         BaldwinWeber "baldwin-weber", unit: false, error: Record,
             precomputed(crate::triangle::BaldwinWeber);
     }

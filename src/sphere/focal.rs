@@ -30,8 +30,9 @@
 //! 1e-5 of `t` once `c/r` passes about 5; the sphere of the precision lecture vanishes at 4096.
 //! [`FocalUnguarded`] keeps that textbook form (for comparison and benchmarks).
 //!
-//! **Operation count per lane** (measured): miss 4 mul, 2 add, 1 cmp; hit 10 mul, 10 add,
-//! 1 sqrt, 7 cmp; a doubtful lane adds one `f64` evaluation of [`Robust`].
+//! **Operation count per lane** (measured): `ops focal/miss: 4 mul, 2 add, 1 cmp`;
+//! `ops focal/hit: 10 mul, 10 add, 1 sqrt, 9 cmp`; a doubtful lane adds one `f64` evaluation
+//! of [`Robust`] (`ops focal/doubtful: 27 mul, 27 add, 3 div, 2 sqrt, 16 cmp` in all).
 //!
 //! **Requirements.** Rays start exactly at the eye the cache was built for and have unit
 //! directions (`||U|² − 1| ≤ 2^-20`, which any f32 `normalize` meets; [`Pinhole`] makes such
@@ -430,10 +431,11 @@ pub trait FocalKernel {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Focal;
 
-/// The lecture's unguarded focal test: `v² > K`, `t = v ∓ √(v² − K)`. Miss 4 mul, 2 add,
-/// 1 cmp; hit adds 1 sqrt and 3 add. Misclassifies far small spheres (`c/r` beyond about
-/// 2^11) and loses accuracy in `t` from `c/r ≈ 5`. Build its cache with
-/// [`FocalSphere::unguarded`].
+/// The lecture's unguarded focal test: `v² > K`, `t = v ∓ √(v² − K)`.
+/// `ops focal-unguarded/miss: 4 mul, 2 add, 1 cmp`; a hit adds 1 sqrt, 3 add and the 4
+/// interval compares: `ops focal-unguarded/hit: 4 mul, 5 add, 1 sqrt, 5 cmp`. Misclassifies
+/// far small spheres (`c/r` beyond about 2^11) and loses accuracy in `t` from `c/r ≈ 5`. Build
+/// its cache with [`FocalSphere::unguarded`].
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FocalUnguarded;
 
