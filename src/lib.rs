@@ -33,9 +33,9 @@
 //! [`mesh`] (triangles over shared vertex slices), [`bounds`] (bounding spheres and culling),
 //! [`hit`] (records and the closest/any loops), [`registry`] (the one list of kernels that the
 //! checker, the demo, the benchmarks, the firmware and the op-count report walk), [`opcount`]
-//! (the counting lane), and, behind the
-//! `vectors` feature, [`vectors`] (the test-vector parser, runner and digest shared by the
-//! checker, the tests and the firmware).
+//! (the counting lane), and, behind the `vectors` feature, `vectors` (the test-vector parser,
+//! runner and digest shared by the checker, the tests and the firmware) and behind the `demo`
+//! feature `demo` (the scenes and their renderer). `ARCHITECTURE.md` draws the layers.
 //!
 //! ## Example
 //!

@@ -585,7 +585,7 @@ mod examples {
                 if with {
                     let _ = sp::surface(&rp, &s, tc);
                 } else {
-                    let _ = rp.origin().mul_add(rp.dir(), tc);
+                    let _ = rp.origin().along(rp.dir(), tc);
                 }
             })
             .1

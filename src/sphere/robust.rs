@@ -51,7 +51,7 @@ impl SphereKernel for Robust {
         let a = d.length_squared();
         let beta = -f.dot(d);
         // 2. Perpendicular from the centre to the ray, and the discriminant.
-        let l = f.mul_add(d, beta / a);
+        let l = f.along(d, beta / a);
         let r2 = s.radius * s.radius;
         let disc = a * (r2 - l.length_squared());
         // `!(Δ < 0)`: a NaN or infinite Δ (squares that overflowed) goes on to the range
