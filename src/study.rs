@@ -85,8 +85,9 @@ pub struct Entry {
 }
 
 /// The figures the caller measures for a method: the largest relative `t` error per input class
-/// with the number of wrong hit/miss decisions (in [`crate::vectors::accuracy`]'s class order
-/// for the method's kind), and the watertightness counts (rays, leaks, double hits).
+/// with the number of wrong hit/miss decisions (in the class order of `vectors::accuracy`,
+/// feature `vectors`, for the method's kind), and the watertightness counts (rays, leaks,
+/// double hits).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Measured {
     /// `(largest relative t error, wrong decisions)` per class; `None` past the last class.

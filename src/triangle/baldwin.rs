@@ -106,7 +106,7 @@ impl PrecomputedKernel for BaldwinWeber {
             return LaneHit::miss();
         }
         // 2. The hit point, transformed: its x', y' are the barycentrics of B and C.
-        let p = ray.origin.mul_add(ray.dir, t);
+        let p = ray.origin.along(ray.dir, t);
         let u = m.rows[0].dot(p) + m.w[0];
         let v = m.rows[1].dot(p) + m.w[1];
         mask = mask & u.ge(zero) & v.ge(zero) & (u + v).le(one);

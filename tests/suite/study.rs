@@ -72,7 +72,7 @@ pub fn report() -> String {
             Shape::Triangle => Kind::Triangle,
             Shape::Sphere => Kind::Sphere,
         };
-        let method = Method::parse(e.method).expect("every study method is in the checker");
+        let method = Method::from_name(e.method).expect("every study method is in the checker");
         let mut m = Measured::default();
         let classes = CLASSES.iter().enumerate().filter(|(_, c)| c.kind == kind);
         for (slot, (k, c)) in m.accuracy.iter_mut().zip(classes) {
