@@ -24,9 +24,14 @@ use raylane::triangle::{self, Cramer, Cull, FocalTriangle, Moller, Triangle};
 use raylane::triangle::{TrianglePacket, Watertight};
 use raylane::{Hit, HitRecord, Lane, Mask, Pinhole, Ray, RayPacket};
 
+pub mod bvh_raylane;
+pub mod meshes;
 pub mod parts;
 pub mod scene;
+pub mod subdivide;
 
+#[cfg(feature = "peers")]
+pub mod bvh_peers;
 #[cfg(feature = "peers")]
 pub mod embree;
 #[cfg(feature = "peers")]
