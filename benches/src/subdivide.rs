@@ -123,3 +123,48 @@ pub fn load_bunny_bin(b: &[u8]) -> Option<(Vec<Vec3>, Vec<[u32; 3]>)> {
     (b.len() == base + 6 * nt && idx.iter().flatten().all(|&i| (i as usize) < nv))
         .then_some((pos, idx))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Every edge of a closed mesh is shared by exactly two triangles, in opposite directions.
+    fn closed(tris: &[[u32; 3]]) -> bool {
+        let mut edges = HashMap::new();
+        for t in tris {
+            for k in 0..3 {
+                *edges.entry((t[k], t[(k + 1) % 3])).or_insert(0) += 1;
+            }
+        }
+        edges
+            .iter()
+            .all(|(&(a, b), &n)| n == 1 && edges.get(&(b, a)) == Some(&1))
+    }
+
+    #[test]
+    fn a_closed_mesh_stays_closed_and_shrinks_inside_its_hull() {
+        let pos = [Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::Z];
+        let tris = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
+        assert!(closed(&tris));
+        let (p, t) = loop_subdivide(&pos, &tris, 3);
+        assert_eq!((p.len(), t.len()), (4 + 6 + 24 + 96, 4 * 64));
+        assert!(closed(&t));
+        // Loop's vertices are convex combinations: inside the tetrahedron.
+        assert!(
+            p.iter()
+                .all(|v| v.min_element() >= 0.0 && v.x + v.y + v.z <= 1.0 + 1e-6)
+        );
+        // Deterministic.
+        assert_eq!(loop_subdivide(&pos, &tris, 3), (p, t));
+    }
+
+    #[test]
+    fn the_vendored_bunny_subdivides_to_940544_triangles() {
+        let (pos, tris) = load_bunny_bin(include_bytes!("../../tests/data/bunny.bin")).unwrap();
+        assert_eq!((pos.len(), tris.len()), (1839, 3674));
+        let (p, t) = loop_subdivide(&pos, &tris, 4);
+        assert_eq!(t.len(), 940_544);
+        assert!(p.iter().all(|v| v.is_finite()));
+        assert!(t.iter().flatten().all(|&i| (i as usize) < p.len()));
+    }
+}
