@@ -172,7 +172,7 @@ impl<L: Lane> Hit<L> {
 
     /// Takes the hits of `h` in the lanes of `take` for primitive `index`.
     #[inline(always)]
-    fn take(&mut self, h: &LaneHit<L>, take: L::Mask, index: u32) {
+    pub(crate) fn take(&mut self, h: &LaneHit<L>, take: L::Mask, index: u32) {
         self.t = L::select(take, h.t, self.t);
         self.u = L::select(take, h.u, self.u);
         self.v = L::select(take, h.v, self.v);
@@ -184,7 +184,7 @@ impl<L: Lane> Hit<L> {
     /// Divides the winners' barycentrics by their denominators (once per ray), with `−0`
     /// made `+0` in `t`, `u`, `v` (`x + 0`).
     #[inline(always)]
-    fn finish(mut self) -> Self {
+    pub(crate) fn finish(mut self) -> Self {
         self.t = plus_zero(self.t);
         self.u = plus_zero(self.u / self.w);
         self.v = plus_zero(self.v / self.w);
@@ -212,7 +212,7 @@ fn closer<L: Lane>(h: &LaneHit<L>, best: &Hit<L>) -> L::Mask {
 /// The relaxed upper end after a hit at `t`: `t + |t|·2^-21` (> t after rounding), so that a
 /// kernel's rounded `num < t_max·den` never rejects a hit that rounds below `t`.
 #[inline(always)]
-fn relax<L: Lane>(t: L) -> L {
+pub(crate) fn relax<L: Lane>(t: L) -> L {
     t + t.abs() * L::from_f32(1.0 / 2_097_152.0)
 }
 

@@ -1,0 +1,546 @@
+//! The BVH (issue 14, items 1–3): built over caller storage, its closest hit equals brute
+//! force's with the same kernel bit for bit (`t`, `u`, `v`, index; ties to the lower index) at
+//! every width, `any` agrees, and bad input builds a valid tree.
+//!
+//! Scenes: random triangle soups and sphere sets, the vendored bunny, the watertightness
+//! edge/vertex sets (every hit of every ray equals brute force's, so the BVH leaks exactly as
+//! often as Watertight does: never), rays that graze box faces exactly and run along them,
+//! and bad input (NaN/inf and coincident vertices, empty and one-triangle meshes, a thousand
+//! copies of one triangle, all primitives at one point, coordinates near `1e30`).
+
+use glam::Vec3;
+use rand::rngs::SmallRng;
+use rand::{Rng, SeedableRng};
+use raylane::bvh::{self, BuildError, Bvh, Leaf, Node, Primitives, Scratch, Sphere4, Tri4};
+use raylane::mesh::Mesh;
+use raylane::sphere::{self, Robust, Sphere};
+use raylane::triangle::{self, Cull, Triangle, Watertight};
+use raylane::{HitRecord, Lane, Mask, Ray, RayPacket};
+use wide::{f32x4, f32x8, f32x16};
+
+/// A tree over `p` in owned vectors trimmed to what the build used.
+fn owned<P: Primitives + ?Sized>(p: &P) -> (Vec<Node>, Vec<P::Leaf>) {
+    let need = bvh::needed(p.count());
+    let mut nodes = vec![Node::EMPTY; need.nodes];
+    let mut leaves = vec![P::Leaf::EMPTY; need.leaves];
+    let mut scratch = vec![Scratch::default(); need.scratch];
+    let (n, l) = {
+        let b = bvh::build(p, &mut nodes, &mut leaves, &mut scratch).expect("storage from needed");
+        (b.nodes().len(), b.leaves().len())
+    };
+    nodes.truncate(n);
+    leaves.truncate(l);
+    (nodes, leaves)
+}
+
+/// The record's bits (so `-0`/`+0` and NaN payloads would show).
+fn bits(h: Option<HitRecord>) -> Option<[u32; 4]> {
+    h.map(|h| [h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.index])
+}
+
+fn v3(rng: &mut SmallRng, s: f32) -> Vec3 {
+    Vec3::new(
+        rng.random_range(-s..s),
+        rng.random_range(-s..s),
+        rng.random_range(-s..s),
+    )
+}
+
+/// Random rays at a scene in `[-1, 1]^3`: half aimed at `aim` points (so they hit), some with
+/// finite or negative interval ends.
+fn rays(rng: &mut SmallRng, n: usize, aim: &[Vec3]) -> Vec<Ray> {
+    (0..n)
+        .map(|i| {
+            let o = v3(rng, 3.0);
+            let d = if i % 2 == 0 && !aim.is_empty() {
+                aim[rng.random_range(0..aim.len())] - o
+            } else {
+                v3(rng, 1.0)
+            };
+            match i % 5 {
+                0 => Ray::with_interval(o, d, 0.0, rng.random_range(0.2..2.0)),
+                1 => Ray::with_interval(o, d, -rng.random_range(0.0..2.0), f32::INFINITY),
+                _ => Ray::new(o, d),
+            }
+        })
+        .collect()
+}
+
+/// Brute force and the BVH on every ray: single-ray `closest`/`any` and packets of 1, 4, 8,
+/// 16 rays, bit for bit. Returns the number of hits.
+fn check<P: Leaf>(
+    bvh: &Bvh<P>,
+    rays: &[Ray],
+    brute: &dyn Fn(&Ray) -> Option<HitRecord>,
+    brute_any: &dyn Fn(&Ray) -> bool,
+    packets: &dyn Fn(&[Ray], &Bvh<P>),
+) -> usize {
+    let mut hits = 0;
+    for (i, r) in rays.iter().enumerate() {
+        let want = brute(r);
+        hits += want.is_some() as usize;
+        assert_eq!(bits(bvh.closest(r)), bits(want), "ray {i}: {r:?}");
+        assert_eq!(bvh.any(r), brute_any(r), "any, ray {i}: {r:?}");
+    }
+    packets(rays, bvh);
+    hits
+}
+
+macro_rules! packet_check {
+    ($name:ident, $brute:expr, $brute_any:expr) => {
+        fn $name<P: Leaf, L: Lane<Scalar = f32>>(rays: &[Ray], bvh: &Bvh<P>, ctx: &Ctx) {
+            for (c, chunk) in rays.chunks(L::LANES).enumerate() {
+                let p = RayPacket::<L>::from_rays(chunk);
+                let want = $brute(ctx, &p);
+                let got = bvh.closest_packet(&p);
+                for i in 0..L::LANES {
+                    assert_eq!(
+                        bits(got.lane(i)),
+                        bits(want.lane(i)),
+                        "{} lanes, packet {c}, lane {i}: {:?}",
+                        L::LANES,
+                        chunk.get(i)
+                    );
+                }
+                let want_any: L::Mask = $brute_any(ctx, &p);
+                assert_eq!(bvh.any_packet(&p).bits(), want_any.bits());
+            }
+        }
+    };
+}
+
+/// What the brute-force packet checks run over.
+enum Ctx<'a> {
+    Tris(&'a [Triangle]),
+    Mesh(Mesh<'a>),
+    Spheres(&'a [Sphere]),
+}
+
+fn brute_packet<L: Lane>(ctx: &Ctx, p: &RayPacket<L>) -> raylane::hit::Hit<L> {
+    match ctx {
+        Ctx::Tris(t) => triangle::closest::<Watertight, L>(p, t, Cull::None),
+        Ctx::Mesh(m) => m.closest::<Watertight, L>(p, Cull::None),
+        Ctx::Spheres(s) => sphere::closest::<Robust, L>(p, s),
+    }
+}
+
+fn brute_any_packet<L: Lane>(ctx: &Ctx, p: &RayPacket<L>) -> L::Mask {
+    match ctx {
+        Ctx::Tris(t) => triangle::any::<Watertight, L>(p, t, Cull::None),
+        Ctx::Mesh(m) => m.any::<Watertight, L>(p, Cull::None),
+        Ctx::Spheres(s) => sphere::any::<Robust, L>(p, s),
+    }
+}
+
+packet_check!(packets_of, brute_packet, brute_any_packet);
+
+fn all_widths<P: Leaf>(rays: &[Ray], bvh: &Bvh<P>, ctx: &Ctx) {
+    packets_of::<P, f32>(rays, bvh, ctx);
+    packets_of::<P, f32x4>(rays, bvh, ctx);
+    packets_of::<P, f32x8>(rays, bvh, ctx);
+    packets_of::<P, f32x16>(rays, bvh, ctx);
+}
+
+fn scalar(ctx: &Ctx, r: &Ray) -> Option<HitRecord> {
+    brute_packet::<f32>(ctx, &RayPacket::splat(r)).get()
+}
+
+fn scalar_any(ctx: &Ctx, r: &Ray) -> bool {
+    brute_any_packet::<f32>(ctx, &RayPacket::splat(r))
+}
+
+/// Checks a triangle set against brute force on `rays`; returns the hit count.
+fn check_tris(tris: &[Triangle], rays: &[Ray]) -> usize {
+    let (nodes, leaves) = owned(tris);
+    let tree = Bvh::from_parts(&nodes, &leaves).expect("a valid tree");
+    let ctx = Ctx::Tris(tris);
+    check(
+        &tree,
+        rays,
+        &|r| scalar(&ctx, r),
+        &|r| scalar_any(&ctx, r),
+        &|rs, b| all_widths(rs, b, &ctx),
+    )
+}
+
+fn check_spheres(spheres: &[Sphere], rays: &[Ray]) -> usize {
+    let (nodes, leaves) = owned(spheres);
+    let tree = Bvh::from_parts(&nodes, &leaves).expect("a valid tree");
+    let ctx = Ctx::Spheres(spheres);
+    check(
+        &tree,
+        rays,
+        &|r| scalar(&ctx, r),
+        &|r| scalar_any(&ctx, r),
+        &|rs, b| all_widths(rs, b, &ctx),
+    )
+}
+
+fn soup(rng: &mut SmallRng, n: usize) -> Vec<Triangle> {
+    (0..n)
+        .map(|_| {
+            let a = v3(rng, 1.0);
+            let s = rng.random_range(0.02..0.4);
+            Triangle::new(a, a + v3(rng, s), a + v3(rng, s))
+        })
+        .collect()
+}
+
+fn centroids(tris: &[Triangle]) -> Vec<Vec3> {
+    tris.iter()
+        .filter(|t| t.is_valid())
+        .map(|t| (t.a() + t.b() + t.c()) / 3.0)
+        .collect()
+}
+
+#[test]
+fn random_triangle_soups_equal_brute_force() {
+    let mut rng = SmallRng::seed_from_u64(14);
+    for n in [1usize, 2, 5, 9, 33, 200, 1500] {
+        let tris = soup(&mut rng, n);
+        let rs = rays(&mut rng, 800, &centroids(&tris));
+        let hits = check_tris(&tris, &rs);
+        assert!(hits > 100, "{n} triangles: only {hits} hits");
+    }
+}
+
+#[test]
+fn random_sphere_sets_equal_brute_force() {
+    let mut rng = SmallRng::seed_from_u64(15);
+    for n in [1usize, 3, 8, 100, 1000] {
+        let spheres: Vec<Sphere> = (0..n)
+            .map(|_| Sphere::new(v3(&mut rng, 1.0), rng.random_range(0.01..0.2)))
+            .collect();
+        let aim: Vec<Vec3> = spheres.iter().map(|s| s.center()).collect();
+        let rs = rays(&mut rng, 800, &aim);
+        let hits = check_spheres(&spheres, &rs);
+        assert!(hits > 100, "{n} spheres: only {hits} hits");
+    }
+}
+
+#[test]
+fn vendored_bunny_equals_brute_force() {
+    let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
+    let mesh = Mesh::new(&m.pos, &m.idx);
+    let (nodes, leaves) = owned(&mesh);
+    let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
+    let (lo, hi) = m.pos.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(l, h), &p| (l.min(p), h.max(p)),
+    );
+    let (c, r) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+    let mut rng = SmallRng::seed_from_u64(16);
+    let mut rs = Vec::new();
+    for _ in 0..12 {
+        let eye = c + v3(&mut rng, 1.0).normalize_or(Vec3::X) * r * rng.random_range(1.2..4.0);
+        for _ in 0..200 {
+            let target = c + v3(&mut rng, r * 0.8);
+            rs.push(Ray::new(eye, target - eye));
+        }
+    }
+    let ctx = Ctx::Mesh(mesh);
+    let hits = check(
+        &tree,
+        &rs,
+        &|r| scalar(&ctx, r),
+        &|r| scalar_any(&ctx, r),
+        &|rs, b| all_widths(rs, b, &ctx),
+    );
+    assert!(hits > 500, "{hits} hits");
+    let s = tree.stats();
+    assert_eq!(s.primitives, m.idx.len());
+    assert!(s.depth <= bvh::MAX_DEPTH);
+}
+
+/// Every hit of every watertightness ray (aimed at shared vertices and edges) equals brute
+/// force's, so the tree leaks exactly when Watertight does: never (0 leaks, asserted).
+#[test]
+fn watertight_sets_no_leaks_through_the_tree() {
+    for (si, s) in crate::watertight::shapes().iter().enumerate() {
+        let mesh = Mesh::new(&s.pos, &s.idx);
+        let (nodes, leaves) = owned(&mesh);
+        let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
+        let cases = crate::watertight::cases(s, 7 + si as u64);
+        let mut leaks = 0;
+        for c in &cases {
+            let p = RayPacket::<f32>::splat(&c.ray);
+            let mut want = Vec::new();
+            mesh.all::<Watertight, f32>(&p, Cull::None, |i, h| {
+                want.push((i, h.t.to_bits(), h.u.to_bits(), h.v.to_bits()))
+            });
+            let mut got = Vec::new();
+            tree.all_packet(&p, |i, h| {
+                got.push((i, h.t.to_bits(), h.u.to_bits(), h.v.to_bits()))
+            });
+            want.sort();
+            got.sort();
+            assert_eq!(got, want, "{:?}", c.ray);
+            // Crossings: distinct t (relative gap 1e-5) must reach the expected count.
+            let mut ts: Vec<f32> = got.iter().map(|g| f32::from_bits(g.1)).collect();
+            ts.sort_by(f32::total_cmp);
+            ts.dedup_by(|b, a| (*b - *a) <= 1e-5 * a.abs().max(1e-3));
+            leaks += (ts.len() < c.crossings) as usize;
+            assert_eq!(
+                bits(tree.closest(&c.ray)),
+                bits(mesh.closest::<Watertight, f32>(&p, Cull::None).get())
+            );
+        }
+        assert_eq!(leaks, 0, "shape {si}");
+    }
+}
+
+/// Axis-aligned triangles whose boxes share faces, rays lying exactly in those faces, running
+/// along box edges and hitting box corners: nothing is lost to the box test.
+#[test]
+fn rays_grazing_box_faces() {
+    let mut tris = Vec::new();
+    // A 6×6 grid of unit squares in the planes z = 0 and z = 1, and walls at x = k.
+    for i in 0..6 {
+        for j in 0..6 {
+            let (x, y) = (i as f32, j as f32);
+            for z in [0.0, 1.0] {
+                tris.push(Triangle::new(
+                    Vec3::new(x, y, z),
+                    Vec3::new(x + 1.0, y, z),
+                    Vec3::new(x + 1.0, y + 1.0, z),
+                ));
+                tris.push(Triangle::new(
+                    Vec3::new(x, y, z),
+                    Vec3::new(x + 1.0, y + 1.0, z),
+                    Vec3::new(x, y + 1.0, z),
+                ));
+            }
+            tris.push(Triangle::new(
+                Vec3::new(x, y, 0.0),
+                Vec3::new(x, y + 1.0, 0.0),
+                Vec3::new(x, y, 1.0),
+            ));
+        }
+    }
+    let mut rs = Vec::new();
+    let mut rng = SmallRng::seed_from_u64(17);
+    for _ in 0..600 {
+        let k = |rng: &mut SmallRng| rng.random_range(0..7) as f32;
+        let half = |rng: &mut SmallRng| rng.random_range(0..14) as f32 * 0.5;
+        // In a box face (z = 0 or 1, d.z = 0), through grid lines and corners.
+        let z = if rng.random_bool(0.5) { 0.0 } else { 1.0 };
+        let o = Vec3::new(half(&mut rng) - 1.0, half(&mut rng) - 1.0, z);
+        let d = Vec3::new(k(&mut rng) - 3.0, k(&mut rng) - 3.0, 0.0);
+        rs.push(Ray::new(o, d));
+        // Straight down a grid line or corner, and along the walls' planes.
+        let o = Vec3::new(k(&mut rng), half(&mut rng), 3.0);
+        rs.push(Ray::new(o, Vec3::new(0.0, 0.0, -1.0)));
+        rs.push(Ray::new(o, Vec3::new(0.0, -0.0, -2.0)));
+        rs.push(Ray::new(
+            Vec3::new(k(&mut rng), -1.0, 0.5),
+            Vec3::new(0.0, 1.0, 0.0),
+        ));
+        // Oblique through a corner point of the grid.
+        let p = Vec3::new(k(&mut rng), k(&mut rng), z);
+        let o = p + v3(&mut rng, 3.0);
+        rs.push(Ray::new(o, p - o));
+    }
+    let hits = check_tris(&tris, &rs);
+    assert!(hits > 500, "{hits}");
+}
+
+/// Bad input builds a valid tree (accepted by `from_parts`), never panics, and the answers
+/// still equal brute force.
+#[test]
+fn bad_input_builds_valid_trees() {
+    let mut rng = SmallRng::seed_from_u64(18);
+    let nan = f32::NAN;
+    let inf = f32::INFINITY;
+    let a = Vec3::new(0.1, 0.2, 0.3);
+    let tri = Triangle::new(a, Vec3::new(1.0, 0.0, 0.2), Vec3::new(0.0, 1.0, -0.1));
+    let big = 1e30f32;
+    let scenes: Vec<(&str, Vec<Triangle>)> = vec![
+        ("empty", vec![]),
+        ("one", vec![tri]),
+        ("nan/inf", {
+            let mut v = soup(&mut rng, 50);
+            v.push(Triangle::new(Vec3::splat(nan), a, a));
+            v.push(Triangle::new(Vec3::new(inf, 0.0, 0.0), a, -a));
+            v.push(Triangle::new(a, a, Vec3::ONE)); // coincident vertices
+            v.push(Triangle::new(a, a * 2.0, a * 3.0)); // collinear
+            v.rotate_left(7);
+            v
+        }),
+        ("1000 copies", vec![tri; 1000]),
+        ("one point", vec![Triangle::new(a, a, a); 300]),
+        ("near 1e30", {
+            (0..100)
+                .map(|_| {
+                    let p = v3(&mut rng, 1.0) * big;
+                    Triangle::new(p, p + v3(&mut rng, 0.3) * big, p + v3(&mut rng, 0.3) * big)
+                })
+                .collect()
+        }),
+        ("huge and tiny", {
+            let mut v = soup(&mut rng, 40);
+            v.push(Triangle::new(
+                Vec3::new(-big, -big, 0.5),
+                Vec3::new(big, -big, 0.5),
+                Vec3::new(0.0, big, 0.5),
+            ));
+            v
+        }),
+    ];
+    for (name, tris) in &scenes {
+        let aim: Vec<Vec3> = centroids(tris);
+        let mut rs = rays(&mut rng, 300, &aim);
+        if name.contains("1e30") {
+            rs.extend(aim.iter().map(|&p| {
+                let o = v3(&mut rng, 3.0) * big;
+                Ray::new(o, p - o)
+            }));
+        }
+        check_tris(tris, &rs);
+    }
+    // Spheres: invalid radii and centres, one point, huge.
+    let mut spheres: Vec<Sphere> = (0..30)
+        .map(|_| Sphere::new(v3(&mut rng, 1.0), 0.1))
+        .collect();
+    spheres.push(Sphere::new(a, -1.0));
+    spheres.push(Sphere::new(Vec3::splat(nan), 1.0));
+    spheres.push(Sphere::new(a, inf));
+    spheres.extend([Sphere::new(a, 0.05); 50]);
+    spheres.push(Sphere::new(Vec3::splat(3e38), 3e38));
+    let aim: Vec<Vec3> = spheres.iter().map(|s| s.center()).collect();
+    let rs = rays(&mut rng, 300, &aim);
+    check_spheres(&spheres, &rs);
+    // Rays with extreme directions and zero components.
+    let tris = soup(&mut rng, 100);
+    let mut rs = Vec::new();
+    for &s in &[1e-30f32, 1e-10, 1e10, 1e30] {
+        for p in centroids(&tris).iter().take(20) {
+            let o = v3(&mut rng, 3.0);
+            rs.push(Ray::new(o, (*p - o) * s));
+            rs.push(Ray::new(Vec3::new(p.x, p.y, 4.0), Vec3::new(0.0, 0.0, -s)));
+        }
+    }
+    check_tris(&tris, &rs);
+}
+
+#[test]
+fn short_storage_is_an_error() {
+    let mut rng = SmallRng::seed_from_u64(19);
+    let tris = soup(&mut rng, 100);
+    let need = bvh::needed(tris.len());
+    let mut nodes = vec![Node::EMPTY; need.nodes];
+    let mut leaves = vec![Tri4::EMPTY; need.leaves];
+    let mut scratch = vec![Scratch::default(); need.scratch];
+    assert_eq!(
+        bvh::build(
+            &tris[..],
+            &mut nodes[..need.nodes - 1],
+            &mut leaves,
+            &mut scratch
+        )
+        .err(),
+        Some(BuildError::Nodes(need.nodes))
+    );
+    assert_eq!(
+        bvh::build(&tris[..], &mut nodes, &mut leaves[..3], &mut scratch).err(),
+        Some(BuildError::Leaves(need.leaves))
+    );
+    assert_eq!(
+        bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch[..0]).err(),
+        Some(BuildError::Scratch(need.scratch))
+    );
+    assert!(bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch).is_ok());
+    assert_eq!(bvh::needed(0).nodes, 1);
+}
+
+/// Same input, same bytes (the builder uses no hashing, no addresses, no fused operations).
+#[test]
+fn builds_are_deterministic() {
+    let mut rng = SmallRng::seed_from_u64(20);
+    let tris = soup(&mut rng, 3000);
+    let (n1, l1) = owned(&tris[..]);
+    let (n2, l2) = owned(&tris[..]);
+    assert_eq!(n1, n2);
+    // Compared as bits: unused lanes hold NaN.
+    let leaf_bits = |l: &[Tri4]| -> Vec<u32> {
+        l.iter()
+            .flat_map(|t| {
+                [t.a, t.b, t.c]
+                    .into_iter()
+                    .flatten()
+                    .flatten()
+                    .map(f32::to_bits)
+                    .chain(t.index)
+                    .collect::<Vec<_>>()
+            })
+            .collect()
+    };
+    assert_eq!(leaf_bits(&l1), leaf_bits(&l2));
+    // Leaves hold every triangle exactly once.
+    let mut seen = vec![false; tris.len()];
+    for l in &l1 {
+        for &i in &l.index {
+            if i != bvh::EMPTY {
+                assert!(!seen[i as usize]);
+                seen[i as usize] = true;
+            }
+        }
+    }
+    assert!(seen.iter().all(|&s| s));
+}
+
+#[test]
+fn refit_after_moving_vertices() {
+    let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
+    let mut pos = m.pos.clone();
+    let need = bvh::needed(m.idx.len());
+    let mut nodes = vec![Node::EMPTY; need.nodes];
+    let mut leaves = vec![Tri4::EMPTY; need.leaves];
+    let mut scratch = vec![Scratch::default(); need.scratch];
+    let (n, l) = {
+        let b = bvh::build(
+            &Mesh::new(&pos, &m.idx),
+            &mut nodes,
+            &mut leaves,
+            &mut scratch,
+        )
+        .unwrap();
+        (b.nodes().len(), b.leaves().len())
+    };
+    // A wave through the mesh.
+    for p in &mut pos {
+        *p += Vec3::new((p.y * 40.0).sin() * 0.01, 0.0, (p.x * 30.0).cos() * 0.02);
+    }
+    let mesh = Mesh::new(&pos, &m.idx);
+    let tree = bvh::refit(&mesh, &mut nodes[..n], &mut leaves[..l]).unwrap();
+    let mut rng = SmallRng::seed_from_u64(21);
+    let aim: Vec<Vec3> = (0..200).map(|i| pos[i * 7]).collect();
+    let rs: Vec<Ray> = (0..1500)
+        .map(|i| {
+            let o = aim[i % aim.len()] + v3(&mut rng, 0.5);
+            Ray::new(o, aim[(i * 13) % aim.len()] - o)
+        })
+        .collect();
+    let ctx = Ctx::Mesh(mesh);
+    let hits = check(
+        &tree,
+        &rs,
+        &|r| scalar(&ctx, r),
+        &|r| scalar_any(&ctx, r),
+        &|rs, b| packets_of::<Tri4, f32x8>(rs, b, &ctx),
+    );
+    assert!(hits > 500);
+}
+
+#[test]
+fn from_parts_rejects_broken_trees() {
+    let mut rng = SmallRng::seed_from_u64(22);
+    let tris = soup(&mut rng, 100);
+    let (mut nodes, leaves) = owned(&tris[..]);
+    assert!(Bvh::from_parts(&nodes, &leaves).is_some());
+    assert!(Bvh::<Tri4>::from_parts(&[], &leaves).is_none());
+    nodes[0].child[0] = 0; // a cycle
+    assert!(Bvh::from_parts(&nodes, &leaves).is_none());
+    nodes[0].child[0] = bvh::LEAF | 10_000;
+    assert!(Bvh::from_parts(&nodes, &leaves).is_none());
+    let _ = Sphere4::EMPTY;
+}
