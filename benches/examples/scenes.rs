@@ -30,7 +30,8 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use glam::Vec3;
-use raylane::Ray;
+use raylane::bvh::{Bvh, Leaf};
+use raylane::{Ray, RayPacket};
 use raylane_bench::bvh_peers::{
     EmbreeBvh, EmbreeRays, ObvhsBvh, ParryMesh, obvhs_rays, parry_rays,
 };
@@ -162,7 +163,9 @@ fn run_jobs(
             got
         };
         let (bad, worst) = check(&got, want);
-        let ok = bad as f64 <= 1e-4 * want.len() as f64;
+        // At most one ray in 10^4 (and at least one) may differ: grazing rays between two
+        // triangles, where kernels of different rounding legitimately disagree.
+        let ok = bad <= (want.len() / 10_000).max(1);
         if !ok {
             println!(
                 "    {:<44} {bad} rays differ, max |Δt|/t {worst:.1e}  FAILED: not timed",
@@ -207,6 +210,9 @@ fn normal(m: &MeshData, i: u32) -> Vec3 {
     let p = |k: u32| m.positions[k as usize];
     (p(b) - p(a)).cross(p(c) - p(a))
 }
+
+/// raylane's BVH's name in the build table.
+const BVH: &str = "raylane BVH";
 
 /// Scenes above this many primitives are checked, and traced by raylane's brute force, on
 /// every [`STRIDE`]-th ray only (every ray otherwise).
@@ -293,6 +299,61 @@ fn peer_jobs<'a>(
     jobs
 }
 
+/// raylane's BVH on every ray of one kind: single rays and packets of 8 and 16.
+fn bvh_jobs<'a, P: Leaf>(
+    shadow: bool,
+    all: &'a [Ray],
+    t: &'a Bvh<'a, P>,
+    keep: &'a Keep,
+) -> Vec<Job<'a>> {
+    let b8: &Vec<RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(all));
+    let b16: &Vec<RayPacket<f32x16>> = keep.put(rl::packets::<f32x16>(all));
+    let (n, every) = (all.len(), (all.len(), true));
+    if shadow {
+        vec![
+            job(
+                "raylane BVH any x1",
+                every,
+                move || rl::bvh_any1(t, all, None),
+                move || collect(|o| rl::bvh_any1(t, all, o)),
+            ),
+            job(
+                "raylane BVH any x8",
+                every,
+                move || rl::bvh_any(t, b8, n, None),
+                move || collect(|o| rl::bvh_any(t, b8, n, o)),
+            ),
+            job(
+                "raylane BVH any x16",
+                every,
+                move || rl::bvh_any(t, b16, n, None),
+                move || collect(|o| rl::bvh_any(t, b16, n, o)),
+            ),
+        ]
+    } else {
+        vec![
+            job(
+                "raylane BVH x1",
+                every,
+                move || rl::bvh_closest1(t, all, None),
+                move || collect(|o| rl::bvh_closest1(t, all, o)),
+            ),
+            job(
+                "raylane BVH x8",
+                every,
+                move || rl::bvh_closest(t, b8, n, None),
+                move || collect(|o| rl::bvh_closest(t, b8, n, o)),
+            ),
+            job(
+                "raylane BVH x16",
+                every,
+                move || rl::bvh_closest(t, b16, n, None),
+                move || collect(|o| rl::bvh_closest(t, b16, n, o)),
+            ),
+        ]
+    }
+}
+
 /// Keeps the converted rays of a scene alive while its jobs borrow them.
 #[derive(Default)]
 struct Keep(RefCell<Vec<Box<dyn std::any::Any>>>);
@@ -333,7 +394,7 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
     let bounded = parts.meshes();
     let build = start.elapsed();
     let bytes = (36 + 12 + 88) as f64 + 20.0 * parts.len() as f64 / n as f64;
-    let label_bf = format!("raylane brute force + spheres ({size})");
+    let label_bf = "raylane brute force + spheres".to_string();
     res.builds.insert(
         (name.clone(), label_bf.clone()),
         (build.as_secs_f64(), bytes),
@@ -359,6 +420,12 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
         (name.clone(), "parry3d".into()),
         (par.build.as_secs_f64(), f64::NAN),
     );
+    let tree = rl::Tree::mesh(&m.positions, &m.indices);
+    res.builds.insert(
+        (name.clone(), BVH.into()),
+        (tree.build.as_secs_f64(), tree.bytes() as f64 / n as f64),
+    );
+    let tb = tree.bvh();
 
     // The secondary rays start from Embree's primary hits (checked below like every other
     // answer).
@@ -377,7 +444,7 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
         w.diffuse.len(),
         w.shadow.len(),
         if stride > 1 {
-            format!("parts of {size}; reference and brute force on every {stride}th ray")
+            format!("parts of {size}; reference and brute force on every {stride}st ray")
         } else {
             format!("parts of {size}")
         },
@@ -403,7 +470,7 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
         };
         ebr.set_coherent(kind == Kind::Primary);
         let mut jobs = peer_jobs(shadow, all, &ebr, &obv, Some(&par), &keep);
-        let s8: &Vec<raylane::RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(&sample));
+        let s8: &Vec<RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(&sample));
         let (b, ns) = (&bounded, sample.len());
         let few = (ns, false);
         if shadow {
@@ -421,16 +488,16 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
                 move || collect(|o| rl::closest(s8, b, ids, ns, o)),
             ));
         }
-        // (raylane's BVH goes here.)
+        jobs.extend(bvh_jobs(shadow, all, &tb, &keep));
         if kind == Kind::Primary {
             // The focal parts over every primary ray, the cache built for the eye inside
             // every frame.
             let (eye, pp, st, nr) = (w.cam.eye, &parts, &store, all.len());
-            let p8: &Vec<raylane::RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(all));
-            let p16: &Vec<raylane::RayPacket<f32x16>> = keep.put(rl::packets::<f32x16>(all));
+            let p8: &Vec<RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(all));
+            let p16: &Vec<RayPacket<f32x16>> = keep.put(rl::packets::<f32x16>(all));
             let every = (nr, true);
             jobs.push(job(
-                format!("raylane focal + spheres ({size}) x8"),
+                "raylane focal + spheres x8",
                 every,
                 move || {
                     let mut s = st.borrow_mut();
@@ -442,7 +509,7 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
                 },
             ));
             jobs.push(job(
-                format!("raylane focal + spheres ({size}) x16"),
+                "raylane focal + spheres x16",
                 every,
                 move || {
                     let mut s = st.borrow_mut();
@@ -491,7 +558,7 @@ fn sphere_scene(res: &mut Results, count: usize, opts: &Opts) {
         frac,
         w.diffuse.len(),
         w.shadow.len(),
-        format!("reference and brute force on every {STRIDE}th ray"),
+        format!("reference and brute force on every {STRIDE}st ray"),
     ));
     res.order.push((name.clone(), count));
     let obv = ObvhsBvh::spheres(&spheres);
@@ -499,6 +566,12 @@ fn sphere_scene(res: &mut Results, count: usize, opts: &Opts) {
         (name.clone(), "obvhs".into()),
         (obv.build.as_secs_f64(), obv.bytes() as f64 / count as f64),
     );
+    let tree = rl::Tree::spheres(&spheres);
+    res.builds.insert(
+        (name.clone(), BVH.into()),
+        (tree.build.as_secs_f64(), tree.bytes() as f64 / count as f64),
+    );
+    let tb = tree.bvh();
     let keep = Keep::default();
     for kind in [Kind::Primary, Kind::Diffuse, Kind::Shadow] {
         let all: &[Ray] = match kind {
@@ -520,7 +593,7 @@ fn sphere_scene(res: &mut Results, count: usize, opts: &Opts) {
         }));
         ebr.set_coherent(kind == Kind::Primary);
         let mut jobs = peer_jobs(shadow, all, &ebr, &obv, None, &keep);
-        let p16: &Vec<raylane::RayPacket<f32x16>> = keep.put(rl::packets::<f32x16>(&sample));
+        let p16: &Vec<RayPacket<f32x16>> = keep.put(rl::packets::<f32x16>(&sample));
         let (sp, ns) = (&spheres, sample.len());
         jobs.push(job(
             "raylane brute force robust x16",
@@ -528,7 +601,7 @@ fn sphere_scene(res: &mut Results, count: usize, opts: &Opts) {
             move || rl::spheres_closest(p16, sp, ns, None),
             move || occluded(collect(|o| rl::spheres_closest(p16, sp, ns, o))),
         ));
-        // (raylane's BVH goes here.)
+        jobs.extend(bvh_jobs(shadow, all, &tb, &keep));
         run_jobs(res, &name, kind, (&want, STRIDE), jobs, runs);
     }
 }
@@ -675,6 +748,40 @@ fn report(res: &Results) {
         }
     }
 
+    println!("\n### Primary rays/s against the number of primitives (fastest variant of each)\n");
+    let families = [
+        ("Embree", "Embree rtc"),
+        ("obvhs", "obvhs"),
+        ("parry3d", "parry3d"),
+        ("raylane brute force + spheres", "raylane brute force"),
+        ("raylane focal + spheres", "raylane focal"),
+        ("raylane BVH", "raylane BVH"),
+    ];
+    let mut head = String::from("| scene | primitives |");
+    let mut rule = String::from("| --- | ---: |");
+    for (f, _) in families {
+        head += &format!(" {f} |");
+        rule += " ---: |";
+    }
+    println!("{head}\n{rule}");
+    for (s, n) in &res.order {
+        let mut row = format!("| {s} | {n} |");
+        for (_, prefix) in families {
+            let best = res
+                .speed
+                .iter()
+                .filter(|((k, ss, c), _)| *k == Kind::Primary && ss == s && c.starts_with(prefix))
+                .map(|(_, v)| *v)
+                .fold(f64::NAN, f64::max);
+            row += &if best.is_nan() {
+                " — |".to_string()
+            } else {
+                format!(" {} |", si(best))
+            };
+        }
+        println!("{row}");
+    }
+
     println!("\n## Goals (issue 14): raylane's fastest contender on each scene\n");
     println!("| goal | scene | raylane | peer | factor | met |");
     println!("| --- | --- | --- | ---: | ---: | --- |");
@@ -723,13 +830,9 @@ fn report(res: &Results) {
     }
     for (s, _) in &res.order {
         let e = res.builds.get(&(s.clone(), "Embree".to_string()));
-        let ours = res
-            .builds
-            .iter()
-            .filter(|((ss, c), _)| ss == s && c.starts_with("raylane"))
-            .map(|((_, c), v)| (c.clone(), v.0))
-            .min_by(|a, b| a.1.total_cmp(&b.1));
-        if let (Some(e), Some((c, t))) = (e, ours) {
+        let ours = res.builds.get(&(s.clone(), BVH.to_string()));
+        if let (Some(e), Some(&(t, _))) = (e, ours) {
+            let c = BVH;
             let f = t / e.0;
             println!(
                 "| build ≤ 2× Embree | {s} | {c}: {:.1} ms | {:.1} ms | {f:.2}× | {} |",

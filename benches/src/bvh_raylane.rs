@@ -7,13 +7,17 @@
 //!   any), and the focal cache for the primary rays (built per eye, inside the timing);
 //! * the reference tracer every contender is checked against: the same parts with the scalar
 //!   `Watertight` kernel (exact brute force, with each hit's triangle index);
-//! * raylane's BVH, once merged, plugs in next to these (see `examples/scenes.rs`).
+//! * raylane's BVH ([`Tree`], [`raylane::bvh`]): built from the indexed mesh or the spheres,
+//!   single rays (`closest`, `any`) and packets of 8 and 16 (`closest_packet`, `any_packet`).
 //!
 //! Every function returns the number of rays hit and, when `out` is given, pushes one answer
 //! per ray (`(t, triangle)`; `(0, 0)` for an occluded shadow ray).
 
 use std::hint::black_box;
+use std::time::{Duration, Instant};
 
+use glam::Vec3;
+use raylane::bvh::{self, Bvh, Leaf, Node, Primitives, Scratch, Sphere4, Tri4};
 use raylane::mesh::{FocalMesh, Mesh};
 use raylane::sphere::{self, Robust, Sphere};
 use raylane::triangle::{Cull, Watertight};
@@ -139,6 +143,135 @@ pub fn spheres_closest<L: Lane<Scalar = f32>>(
         n += h.mask.bits().count_ones();
         if let Some(o) = out.as_deref_mut() {
             o.extend((0..L::LANES).map(|i| h.lane(i).map(|r| (r.t, r.index))));
+        }
+    }
+    if let Some(o) = out {
+        o.truncate(rays);
+    }
+    n
+}
+
+/// raylane's BVH over owned storage (sized by [`bvh::needed`], trimmed to what the build used).
+pub struct Tree<P: Leaf> {
+    nodes: Vec<Node>,
+    leaves: Vec<P>,
+    /// Build time: storage allocation and [`bvh::build`].
+    pub build: Duration,
+}
+
+impl<P: Leaf> Tree<P> {
+    fn new<Q: Primitives<Leaf = P> + ?Sized>(prims: &Q) -> Self {
+        let start = Instant::now();
+        let need = bvh::needed(prims.count());
+        let mut nodes = vec![Node::EMPTY; need.nodes];
+        let mut leaves = vec![P::EMPTY; need.leaves];
+        let mut scratch = vec![Scratch::default(); need.scratch];
+        let (n, l) = {
+            let t = bvh::build(prims, &mut nodes, &mut leaves, &mut scratch)
+                .expect("storage from bvh::needed");
+            (t.nodes().len(), t.leaves().len())
+        };
+        let build = start.elapsed();
+        nodes.truncate(n);
+        leaves.truncate(l);
+        Tree {
+            nodes,
+            leaves,
+            build,
+        }
+    }
+
+    /// The tree.
+    pub fn bvh(&self) -> Bvh<'_, P> {
+        Bvh::from_parts(&self.nodes, &self.leaves).expect("a tree bvh::build made")
+    }
+
+    /// Bytes of the nodes and leaves.
+    pub fn bytes(&self) -> usize {
+        size_of_val(&self.nodes[..]) + size_of_val(&self.leaves[..])
+    }
+}
+
+impl Tree<Tri4> {
+    /// Over an indexed mesh (`Mesh::new(positions, indices)`).
+    pub fn mesh(positions: &[Vec3], indices: &[[u32; 3]]) -> Self {
+        Self::new(&Mesh::new(positions, indices))
+    }
+}
+
+impl Tree<Sphere4> {
+    /// Over spheres.
+    pub fn spheres(spheres: &[Sphere]) -> Self {
+        Self::new(spheres)
+    }
+}
+
+/// Closest hits of single rays through the BVH.
+#[inline(never)]
+pub fn bvh_closest1<P: Leaf>(t: &Bvh<P>, rays: &[Ray], mut out: Option<&mut Answers>) -> u32 {
+    let mut n = 0;
+    for r in rays {
+        let h = t.closest(black_box(r));
+        n += h.is_some() as u32;
+        if let Some(o) = out.as_deref_mut() {
+            o.push(h.map(|h| (h.t, h.index)));
+        }
+        black_box(&h);
+    }
+    n
+}
+
+/// Closest hits of ray packets through the BVH.
+#[inline(never)]
+pub fn bvh_closest<P: Leaf, L: Lane<Scalar = f32>>(
+    t: &Bvh<P>,
+    packets: &[RayPacket<L>],
+    rays: usize,
+    mut out: Option<&mut Answers>,
+) -> u32 {
+    let mut n = 0;
+    for p in packets {
+        let h = t.closest_packet(black_box(p));
+        n += h.mask.bits().count_ones();
+        if let Some(o) = out.as_deref_mut() {
+            o.extend((0..L::LANES).map(|i| h.lane(i).map(|r| (r.t, r.index))));
+        }
+        black_box(&h);
+    }
+    if let Some(o) = out {
+        o.truncate(rays);
+    }
+    n
+}
+
+/// Any hit of single rays through the BVH.
+#[inline(never)]
+pub fn bvh_any1<P: Leaf>(t: &Bvh<P>, rays: &[Ray], mut out: Option<&mut Answers>) -> u32 {
+    let mut n = 0;
+    for r in rays {
+        let h = t.any(black_box(r));
+        n += h as u32;
+        if let Some(o) = out.as_deref_mut() {
+            o.push(h.then_some((0.0, 0)));
+        }
+    }
+    n
+}
+
+/// Any hit of ray packets through the BVH.
+#[inline(never)]
+pub fn bvh_any<P: Leaf, L: Lane<Scalar = f32>>(
+    t: &Bvh<P>,
+    packets: &[RayPacket<L>],
+    rays: usize,
+    mut out: Option<&mut Answers>,
+) -> u32 {
+    let mut n = 0;
+    for p in packets {
+        let m = t.any_packet(black_box(p));
+        n += m.bits().count_ones();
+        if let Some(o) = out.as_deref_mut() {
+            o.extend((0..L::LANES).map(|i| m.test(i).then_some((0.0, 0))));
         }
     }
     if let Some(o) = out {
