@@ -109,9 +109,10 @@ impl LaneHit<f32> {
     }
 }
 
-/// The closest hit per lane over a set of primitives, with the primitive's index.
+/// The closest hit per lane over a set of primitives, with the primitive's index: the state of
+/// the closest-hit loops, finished into [`Hits`](crate::Hits) by the queries.
 #[derive(Clone, Copy, Debug)]
-pub struct Hit<L: Lane> {
+pub struct Best<L: Lane> {
     /// Ray parameter; `+inf` where `mask` is clear.
     pub t: L,
     /// First surface parameter (barycentric weight of B for triangles).
@@ -126,6 +127,10 @@ pub struct Hit<L: Lane> {
     pub(crate) w: L,
 }
 
+/// The former name of [`Best`].
+#[doc(hidden)]
+pub type Hit<L> = Best<L>;
+
 /// One hit of one ray, as the scalar API reports it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HitRecord {
@@ -139,13 +144,13 @@ pub struct HitRecord {
     pub index: u32,
 }
 
-impl<L: Lane> Hit<L> {
+impl<L: Lane> Best<L> {
     /// No hit in any lane.
     #[inline]
     #[must_use]
     pub fn none() -> Self {
         let m = LaneHit::<L>::miss();
-        Hit {
+        Best {
             t: m.t,
             u: m.u,
             v: m.v,
@@ -168,6 +173,16 @@ impl<L: Lane> Hit<L> {
             v: self.v.lane(i),
             index: self.index.as_ref()[i],
         })
+    }
+
+    /// The finished record of one candidate `h` of primitive `index` (for queries that report
+    /// every hit).
+    #[inline(always)]
+    #[must_use]
+    pub(crate) fn single(h: &LaneHit<L>, index: u32) -> Self {
+        let mut b = Self::none();
+        b.take(h, h.mask, index);
+        b.finish()
     }
 
     /// Takes the hits of `h` in the lanes of `take` for primitive `index`.
@@ -205,7 +220,7 @@ fn plus_zero<L: Lane>(x: L) -> L {
 
 /// Lanes of `h` strictly closer than `best` (ties keep the earlier, lower-index hit).
 #[inline(always)]
-fn closer<L: Lane>(h: &LaneHit<L>, best: &Hit<L>) -> L::Mask {
+fn closer<L: Lane>(h: &LaneHit<L>, best: &Best<L>) -> L::Mask {
     h.mask & h.t.lt(best.t)
 }
 
@@ -216,9 +231,7 @@ pub(crate) fn relax<L: Lane>(t: L) -> L {
     t + t.abs() * L::from_f32(1.0 / 2_097_152.0)
 }
 
-impl<L: Lane> Hit<L> {}
-
-impl Hit<f32> {
+impl Best<f32> {
     /// The record, or `None` for a miss.
     #[inline]
     #[must_use]
@@ -237,9 +250,9 @@ pub fn closest<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: impl IntoIterator<Item = P>,
     mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
-) -> Hit<L> {
+) -> Best<L> {
     let mut r = *rays;
-    let mut best = Hit::none();
+    let mut best = Best::none();
     for (i, p) in prims.into_iter().enumerate() {
         // `None`: no lane passed the kernel's first test (nothing to merge on the miss path).
         if let Some(h) = test(&r, p) {
@@ -316,12 +329,12 @@ pub fn closest_filtered<L: Lane, P>(
     prims: &[P],
     mut candidate: impl FnMut(&RayPacket<L>, &P) -> L::Mask,
     mut test: impl FnMut(&RayPacket<L>, &P) -> Option<LaneHit<L>>,
-) -> Hit<L> {
+) -> Best<L> {
     if L::LANES == 1 {
         return closest(rays, prims, test);
     }
     let mut r = *rays;
-    let mut best = Hit::none();
+    let mut best = Best::none();
     for (b, block) in prims.chunks(64).enumerate() {
         let mut bits = candidates(&r, block, &mut candidate);
         while bits != 0 {
@@ -384,7 +397,7 @@ where
     L::Scalar: Scalar,
 {
     let mut r = RayPacket::<L>::splat(ray);
-    let mut best = Hit::<L>::none();
+    let mut best = Best::<L>::none();
     for (c, p) in chunks.into_iter().enumerate() {
         let Some(h) = test(&r, p) else { continue };
         let take = closer(&h, &best);

@@ -61,6 +61,7 @@ pub mod lane;
 pub mod mesh;
 pub mod opcount;
 pub mod plane;
+pub mod query;
 pub mod ray;
 pub mod sphere;
 pub mod study;
@@ -75,7 +76,13 @@ pub mod vectors;
 struct ReadmeDoctests;
 
 pub use camera::Pinhole;
-pub use hit::{Hit, HitRecord, LaneHit};
+pub use hit::{HitRecord, LaneHit};
 pub use lane::{Lane, Mask};
+pub use query::{Hit, Hits, Query, Rays, Using};
 pub use ray::{Ray, Ray4, Ray8, Ray16, RayPacket};
 pub use vec3::V3;
+
+/// The vector library of the API (`raylane::glam::Vec3`): no need to pin its version.
+pub use glam;
+/// The SIMD library of the packets (`raylane::wide::f32x8`).
+pub use wide;

@@ -15,6 +15,7 @@
 use std::hint::black_box;
 
 use glam::Vec3;
+use raylane::hit::Hit;
 use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
 use raylane::sphere::SpherePacket;
 use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
@@ -22,7 +23,7 @@ use raylane::sphere::{self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Ro
 use raylane::triangle::focal as tf;
 use raylane::triangle::{self, Cramer, Cull, FocalTriangle, Moller, Triangle};
 use raylane::triangle::{TrianglePacket, Watertight};
-use raylane::{Hit, HitRecord, Lane, Mask, Pinhole, Ray, RayPacket};
+use raylane::{HitRecord, Lane, Mask, Pinhole, Ray, RayPacket};
 
 pub mod bvh_raylane;
 pub mod meshes;

@@ -11,9 +11,10 @@
 use std::hint::black_box;
 
 use glam::Vec3;
+use raylane::hit::Hit;
 use raylane::mesh::{FocalMesh, Mesh};
 use raylane::triangle::{Cull, FocalRays, FocalTriangle, Triangle};
-use raylane::{Hit, Lane, Mask, RayPacket};
+use raylane::{Lane, Mask, RayPacket};
 
 /// Triangles in parts, each part its own vertex and index arrays (unshared vertices).
 pub struct Parts {

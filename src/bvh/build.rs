@@ -103,15 +103,18 @@ fn sah_split(s: &mut [Scratch]) -> Option<usize> {
 }
 
 /// Splits `s` (more than [`LEAF_WIDTH`] primitives) into two non-empty parts; returns the size
-/// of the first. Binned SAH above [`SAH_DEPTH`], the middle index below it or when SAH finds
-/// no plane.
+/// of the first. Binned SAH above [`SAH_DEPTH`], the middle index (rounded up to a multiple of
+/// [`LEAF_WIDTH`]) below it or when SAH finds no plane.
 fn split(s: &mut [Scratch], depth: u32) -> usize {
     if depth < SAH_DEPTH
         && let Some(mid) = sah_split(s)
     {
         return mid;
     }
-    s.len() / 2
+    // The middle, rounded up to whole leaves where that leaves both sides non-empty.
+    let half = s.len() / 2;
+    let whole = half.div_ceil(LEAF_WIDTH) * LEAF_WIDTH;
+    if whole < s.len() { whole } else { half }
 }
 
 /// Builds a tree over `prims` into `nodes`, `leaves` (sizes from [`needed`]) using `scratch`
@@ -176,16 +179,26 @@ pub fn build<'s, P: Primitives + ?Sized>(
         boxes[0] = range_box(&s[start as usize..end as usize]);
         let mut nk = 1;
         while nk < WIDTH {
+            // SAH levels split the largest area, middle-index levels the largest count (so
+            // that each level divides the largest range by 8: the depth bound).
+            // Equal areas (coincident primitives): the larger count.
             let mut pick: Option<usize> = None;
             let mut best = f32::NEG_INFINITY;
+            let mut best_count = 0;
             for k in 0..nk {
-                if (kids[k].1 - kids[k].0) as usize <= LEAF_WIDTH {
+                let count = (kids[k].1 - kids[k].0) as usize;
+                if count <= LEAF_WIDTH {
                     continue;
                 }
-                let a = area(boxes[k].0, boxes[k].1);
-                if pick.is_none() || a > best {
+                let a = if depth < SAH_DEPTH {
+                    area(boxes[k].0, boxes[k].1)
+                } else {
+                    count as f32
+                };
+                if pick.is_none() || a > best || (a == best && count > best_count) {
                     pick = Some(k);
                     best = a;
+                    best_count = count;
                 }
             }
             let Some(k) = pick else { break };

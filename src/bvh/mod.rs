@@ -17,9 +17,10 @@
 //! * **Deterministic.** Only IEEE-exact operations (comparisons, `+ − ×` in a fixed order, no
 //!   fused multiply-add) and fixed tie-breaking (lowest axis, lowest bin, lowest slot): the
 //!   same tree, bit for bit, on every target.
-//! * **Bounded depth.** Below depth [`SAH_DEPTH`] ranges are split at their middle index, so
-//!   the depth never exceeds [`MAX_DEPTH`] (for up to `2^31` primitives), and the traversal's
-//!   fixed-size stack ([`STACK`] entries) cannot overflow.
+//! * **Bounded depth.** From depth [`SAH_DEPTH`] on, ranges are split at their middle index
+//!   (largest range first), so the depth never exceeds [`MAX_DEPTH`] (for up to `2^31`
+//!   primitives), and the traversal's fixed-size stack ([`STACK`] entries, 2 KB) cannot
+//!   overflow; [`Bvh::from_parts`] refuses deeper trees.
 //! * **Bad input.** A primitive that no kernel can hit (NaN or infinite coordinates, zero area,
 //!   non-positive radius) gets an empty box and is never visited; coincident primitives are
 //!   split by index; nothing panics or loops.
@@ -82,11 +83,12 @@ pub const LEAF_WIDTH: usize = 4;
 /// Bins per axis of the binned SAH.
 pub const BINS: usize = 16;
 /// Depth from which ranges are split at their middle index instead of by SAH.
-pub const SAH_DEPTH: u32 = 32;
-/// The deepest a built tree gets: the root is depth 1; below [`SAH_DEPTH`] each level at least
-/// halves the largest range, so `2^31` primitives need at most 31 more levels.
-pub const MAX_DEPTH: u32 = SAH_DEPTH + 32;
-/// Entries of the traversal stack: at most `WIDTH − 1` siblings wait per level.
+pub const SAH_DEPTH: u32 = 24;
+/// The deepest a built tree gets: the root is depth 1; from [`SAH_DEPTH`] on, a node splits
+/// its largest range 7 times at the middle index, so each level divides the largest range by
+/// 8, and `2^31` primitives reach leaves of at most 4 within 10 more levels.
+pub const MAX_DEPTH: u32 = SAH_DEPTH + 11;
+/// Entries of the traversal stack: at most `WIDTH − 1` siblings wait per level, plus one.
 pub const STACK: usize = (WIDTH - 1) * MAX_DEPTH as usize + 1;
 /// `child[k]` of an unused slot.
 pub const EMPTY: u32 = u32::MAX;
@@ -208,7 +210,8 @@ pub type SphereBvh<'s> = Bvh<'s, Sphere4>;
 impl<'s, P: Leaf> Bvh<'s, P> {
     /// Reopens a tree from its two slices (e.g. `static` data built on a host). Returns `None`
     /// when the slices are not a tree as [`build`] makes them: no nodes, a child index out of
-    /// range, or an inner child not after its parent.
+    /// range, an inner child not after its parent, a node reached twice, or a depth above
+    /// [`MAX_DEPTH`] (linear in the number of nodes).
     #[must_use]
     pub fn from_parts(nodes: &'s [Node], leaves: &'s [P]) -> Option<Self> {
         if nodes.is_empty() {
@@ -228,6 +231,7 @@ impl<'s, P: Leaf> Bvh<'s, P> {
                 }
             }
         }
+        depth(nodes)?;
         Some(Bvh {
             nodes,
             leaves,
@@ -271,8 +275,6 @@ impl<'s, P: Leaf> Bvh<'s, P> {
         };
         let mut sah = 1.0f64; // the root's traversal
         let mut prims = 0usize;
-        // Depth by a pass in index order (parents come before children).
-        let mut max_depth = 1u32;
         for n in self.nodes {
             for k in 0..WIDTH {
                 let c = n.child[k];
@@ -298,22 +300,7 @@ impl<'s, P: Leaf> Bvh<'s, P> {
                 }
             }
         }
-        // Depth: an explicit walk with a fixed stack of (node, depth).
-        let mut stack = [(0u32, 1u32); STACK];
-        let mut sp = 1;
-        while sp > 0 {
-            sp -= 1;
-            let (i, d) = stack[sp];
-            max_depth = max_depth.max(d);
-            if let Some(n) = self.nodes.get(i as usize) {
-                for &c in &n.child {
-                    if c != EMPTY && c & LEAF == 0 && sp < STACK {
-                        stack[sp] = (c, d + 1);
-                        sp += 1;
-                    }
-                }
-            }
-        }
+        let max_depth = depth(self.nodes).unwrap_or(0);
         Stats {
             nodes: self.nodes.len(),
             leaves: self.leaves.len(),
@@ -323,6 +310,33 @@ impl<'s, P: Leaf> Bvh<'s, P> {
             bytes: core::mem::size_of_val(self.nodes) + core::mem::size_of_val(self.leaves),
         }
     }
+}
+
+/// The depth of the tree under `nodes[0]` (the root alone is 1), or `None` when a node is
+/// reached twice (more visits than nodes), the depth exceeds [`MAX_DEPTH`], or an inner
+/// child does not follow its parent.
+fn depth(nodes: &[Node]) -> Option<u32> {
+    let mut stack = [(0u32, 1u32); STACK];
+    let (mut sp, mut visits, mut deepest) = (1usize, 0usize, 0u32);
+    while sp > 0 {
+        sp -= 1;
+        let (i, d) = stack[sp];
+        visits += 1;
+        if visits > nodes.len() || d > MAX_DEPTH {
+            return None;
+        }
+        deepest = deepest.max(d);
+        for &c in &nodes.get(i as usize)?.child {
+            if c != EMPTY && c & LEAF == 0 {
+                if c <= i {
+                    return None;
+                }
+                *stack.get_mut(sp)? = (c, d + 1);
+                sp += 1;
+            }
+        }
+    }
+    Some(deepest)
 }
 
 /// What [`Bvh::stats`] reports.

@@ -93,24 +93,30 @@ impl Slab {
     }
 }
 
-/// The traversal stack: node references with the entry parameter of their box.
+/// The traversal stack: node references with the entry parameter of their box (the root
+/// first, with `−inf`).
 struct Stack {
-    items: [(u32, f32); STACK],
+    node: [u32; STACK],
+    tn: [f32; STACK],
     len: usize,
 }
 
 impl Stack {
+    #[inline(always)]
     fn new() -> Self {
-        Stack {
-            items: [(0, f32::NEG_INFINITY); STACK],
+        let mut s = Stack {
+            node: [0; STACK],
+            tn: [0.0; STACK],
             len: 1,
-        }
+        };
+        s.tn[0] = f32::NEG_INFINITY;
+        s
     }
 
     #[inline(always)]
     fn pop(&mut self) -> Option<(u32, f32)> {
         self.len = self.len.checked_sub(1)?;
-        self.items.get(self.len).copied()
+        Some((*self.node.get(self.len)?, *self.tn.get(self.len)?))
     }
 
     /// Pushes the children in `bits` farthest first (so the nearest is popped first).
@@ -131,9 +137,10 @@ impl Stack {
             list[j] = item;
             m += 1;
         }
-        for &item in &list[..m] {
-            if let Some(slot) = self.items.get_mut(self.len) {
-                *slot = item;
+        for &(c, t) in &list[..m] {
+            if let (Some(a), Some(b)) = (self.node.get_mut(self.len), self.tn.get_mut(self.len)) {
+                *a = c;
+                *b = t;
                 self.len += 1;
             }
         }

@@ -12,6 +12,7 @@
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use glam::Vec3;
+use raylane::hit::Hit;
 use raylane::mesh::Mesh;
 use raylane::plane::{self, FocalPlane, Plane};
 use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
@@ -24,7 +25,7 @@ use raylane::triangle::{
     KenslerShirley, Moller, Plucker, Triangle, TrianglePacket, Wald, Watertight,
 };
 use raylane::vectors::{Case, Kind, Values};
-use raylane::{Hit, Lane, Mask, Ray, RayPacket};
+use raylane::{Lane, Mask, Ray, RayPacket};
 
 // The critical-section implementations the semihosting crates need (single core / hart).
 #[cfg(target_arch = "arm")]

@@ -544,3 +544,50 @@ fn from_parts_rejects_broken_trees() {
     assert!(Bvh::from_parts(&nodes, &leaves).is_none());
     let _ = Sphere4::EMPTY;
 }
+
+/// Depth stays bounded: copies of one triangle (no SAH plane: middle-index splits, 8 ways per
+/// level) and an exponentially spaced row (SAH peels one triangle per level until
+/// `SAH_DEPTH`). Ties go to the lowest index among the copies.
+#[test]
+fn depth_is_bounded_and_ties_go_to_the_lowest_index() {
+    let tri = Triangle::new(
+        Vec3::new(0.0, 0.0, 0.0),
+        Vec3::new(1.0, 0.0, 0.0),
+        Vec3::new(0.0, 1.0, 0.0),
+    );
+    let copies = vec![tri; 20_000];
+    let (nodes, leaves) = owned(&copies[..]);
+    let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
+    // 20,000 → 2,500 → 313 → 40 → 5 → 1: six levels.
+    assert!(tree.stats().depth <= 6, "{:?}", tree.stats());
+    let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0));
+    assert_eq!(tree.closest(&ray).unwrap().index, 0);
+    let p = RayPacket::<f32x8>::splat(&ray);
+    assert_eq!(tree.closest_packet(&p).lane(5).unwrap().index, 0);
+
+    let row: Vec<Triangle> = (0..400)
+        .map(|i| {
+            let x = 2f32.powf(i as f32 / 4.0);
+            Triangle::new(
+                Vec3::new(x, 0.0, 0.0),
+                Vec3::new(x * 1.1, 0.0, 0.0),
+                Vec3::new(x, x * 0.1, 0.0),
+            )
+        })
+        .collect();
+    let (nodes, leaves) = owned(&row[..]);
+    let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
+    let s = tree.stats();
+    assert!(s.depth <= bvh::MAX_DEPTH, "{s:?}");
+    println!("exponential row: {s:?}");
+    let mut rng = SmallRng::seed_from_u64(23);
+    let rs: Vec<Ray> = (0..400)
+        .map(|i| {
+            let x = 2f32.powf(i as f32 / 4.0) * 1.02;
+            let o = Vec3::new(x, x * 0.01, 1.0) + v3(&mut rng, 0.001);
+            Ray::new(o, Vec3::new(0.0, 0.0, -1.0))
+        })
+        .collect();
+    // Beyond the kernels' range (2^30) rays may miss, in the tree as in brute force.
+    assert!(check_tris(&row, &rs) > 100);
+}

@@ -4,6 +4,7 @@
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
+use raylane::hit::Hit;
 use raylane::lane::{Lane, Mask};
 use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
 use raylane::sphere::focal::{self, Focal, FocalKernel, FocalUnguarded};
@@ -11,7 +12,7 @@ use raylane::sphere::{
     self, EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust, Roots,
     Sphere, SphereKernel, SpherePacket,
 };
-use raylane::{Hit, Ray, RayPacket, V3};
+use raylane::{Ray, RayPacket, V3};
 use wide::{f32x4, f32x8, f32x16};
 
 const BATCHES: usize = 400;

@@ -13,6 +13,7 @@ mod focal_rules;
 mod fuzz;
 mod lanes;
 mod opcount;
+mod query;
 mod readme;
 #[cfg(feature = "demo")]
 mod render;

@@ -9,6 +9,7 @@ use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
 use raylane::demo::shapes;
+use raylane::hit::Hit;
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
 use raylane::opcount::{OpCounts, table};
@@ -18,7 +19,7 @@ use raylane::triangle::{
     KenslerShirley, Moller, Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket,
     Wald, Watertight,
 };
-use raylane::{Hit, LaneHit, Ray, RayPacket};
+use raylane::{LaneHit, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
 const CULLS: [Cull; 2] = [Cull::None, Cull::Back];

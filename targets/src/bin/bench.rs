@@ -15,12 +15,13 @@
 
 use core::hint::black_box;
 
+use raylane::hit::Hit;
 use raylane::plane::{self, FocalPlane, Plane};
 use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
 use raylane::sphere::{self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
 use raylane::triangle::focal as tf;
 use raylane::triangle::{self, Cramer, Cull, FocalTriangle, Moller, Triangle, Watertight};
-use raylane::{Hit, Mask, Ray, RayPacket};
+use raylane::{Mask, Ray, RayPacket};
 use raylane_fw::semihosting::hprintln;
 use raylane_fw::{entry, exit};
 

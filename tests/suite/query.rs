@@ -1,0 +1,265 @@
+//! Queries (issue 11): every lane of a packet query at widths 1, 4, 8 and 16 equals the one-ray
+//! query, bit for bit, in every field of the record; the records keep the `t`, `u`, `v` and
+//! index of the existing closest-hit loops; points and normals are what they claim.
+//!
+//! Over seeded random rays (some with NaN, infinite or zero directions, some not unit length)
+//! against random spheres and planes and the vendored bunny, for the default kernels, other
+//! kernels through `using`, culled queries and a scene of three sets.
+
+use glam::Vec3;
+use rand::rngs::SmallRng;
+use rand::{Rng, SeedableRng};
+use raylane::lane::{Lane, Mask};
+use raylane::plane::Plane;
+use raylane::sphere::{self, Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
+use raylane::triangle::{self, Cull, Moller, Triangle, Watertight};
+use raylane::{Hit, Hits, Query, Ray, RayPacket};
+use wide::{f32x4, f32x8, f32x16};
+
+use crate::bunny::load_bin;
+
+fn coord(rng: &mut SmallRng, scale: f32) -> f32 {
+    match rng.random_range(0..200) {
+        0 => f32::NAN,
+        1 => f32::INFINITY,
+        2 => 0.0,
+        _ => rng.random_range(-scale..scale),
+    }
+}
+
+fn vec(rng: &mut SmallRng, scale: f32) -> Vec3 {
+    Vec3::new(coord(rng, scale), coord(rng, scale), coord(rng, scale))
+}
+
+/// Rays around a model of size `scale` centred at `c`: mostly aimed at it.
+fn ray(rng: &mut SmallRng, c: Vec3, scale: f32) -> Ray {
+    let o = c + vec(rng, 3.0 * scale);
+    let d = match rng.random_range(0..10) {
+        0 => Vec3::ZERO,
+        1 => vec(rng, 3.0),
+        2..=7 => (c + vec(rng, 0.5 * scale) - o).normalize_or_zero(),
+        _ => vec(rng, 1.0).normalize_or_zero(),
+    };
+    if rng.random_range(0..8) == 0 {
+        Ray::with_interval(o, d, -1.0, rng.random_range(0.0..4.0 * scale))
+    } else {
+        Ray::new(o, d)
+    }
+}
+
+fn bits(h: Option<Hit>) -> Option<[u32; 12]> {
+    h.map(|h| {
+        [
+            h.t.to_bits(),
+            h.point.x.to_bits(),
+            h.point.y.to_bits(),
+            h.point.z.to_bits(),
+            h.normal.x.to_bits(),
+            h.normal.y.to_bits(),
+            h.normal.z.to_bits(),
+            h.front as u32,
+            h.index,
+            h.set,
+            h.u.to_bits(),
+            h.v.to_bits(),
+        ]
+    })
+}
+
+/// Every lane of `q`'s packet answers for `rays` equals the one-ray answers; returns the
+/// one-ray closest hits.
+fn same<Q: Query + ?Sized, L: Lane<Scalar = f32>>(
+    q: &Q,
+    rays: &[Ray],
+    what: &str,
+) -> Vec<Option<Hit>> {
+    let mut out = Vec::new();
+    for chunk in rays.chunks(L::LANES) {
+        let p = RayPacket::<L>::from_rays(chunk);
+        let hits: Hits<L> = q.closest(&p);
+        let any = q.any(&p);
+        let mut all: Vec<Vec<[u32; 12]>> = vec![Vec::new(); L::LANES];
+        q.all(&p, |h: Hits<L>| {
+            for (i, v) in all.iter_mut().enumerate() {
+                if let Some(b) = bits(h.lane(i)) {
+                    v.push(b);
+                }
+            }
+        });
+        for (i, r) in chunk.iter().enumerate() {
+            let one = q.closest(r);
+            assert_eq!(
+                bits(hits.lane(i)),
+                bits(one),
+                "{what}: closest, lane {i}, {r:?}"
+            );
+            assert_eq!(any.test(i), q.any(r), "{what}: any, lane {i}, {r:?}");
+            assert_eq!(any.test(i), one.is_some(), "{what}: any vs closest, {r:?}");
+            let mut each = Vec::new();
+            q.all(r, |h: Hit| each.push(bits(Some(h)).unwrap()));
+            assert_eq!(all[i], each, "{what}: all, lane {i}, {r:?}");
+            if let Some(h) = one {
+                check_record(&h, r, what);
+                assert!(
+                    each.contains(&bits(one).unwrap()),
+                    "{what}: all lacks the closest"
+                );
+            }
+            out.push(one);
+        }
+        for i in chunk.len()..L::LANES {
+            assert!(
+                !hits.mask.test(i) && !any.test(i),
+                "{what}: padding lane {i} hit"
+            );
+        }
+    }
+    out
+}
+
+fn check_record(h: &Hit, r: &Ray, what: &str) {
+    assert!(h.t > r.t_min() && h.t < r.t_max(), "{what}: t outside");
+    assert_eq!(h.point, r.at(h.t), "{what}: point is o + t·d");
+    let n = h.normal.length();
+    assert!((n - 1.0).abs() < 1e-6, "{what}: |normal| = {n}");
+    assert!(
+        h.normal.dot(r.dir()) <= 0.0,
+        "{what}: normal faces away from the origin"
+    );
+    for x in [h.u, h.v] {
+        assert!((0.0..=1.0).contains(&x), "{what}: barycentric {x}");
+    }
+}
+
+fn every_width<Q: Query + ?Sized>(q: &Q, rays: &[Ray], what: &str) -> Vec<Option<Hit>> {
+    let one = same::<Q, f32>(q, rays, what);
+    for w in [
+        same::<Q, f32x4>(q, rays, what),
+        same::<Q, f32x8>(q, rays, what),
+        same::<Q, f32x16>(q, rays, what),
+    ] {
+        assert_eq!(
+            w.iter().map(|h| bits(*h)).collect::<Vec<_>>(),
+            one.iter().map(|h| bits(*h)).collect::<Vec<_>>()
+        );
+    }
+    one
+}
+
+fn spheres(rng: &mut SmallRng, n: usize) -> Vec<Sphere> {
+    (0..n)
+        .map(|_| {
+            let r = match rng.random_range(0..20) {
+                0 => -1.0,
+                1 => f32::NAN,
+                _ => rng.random_range(0.05..3.0),
+            };
+            Sphere::new(vec(rng, 8.0), r)
+        })
+        .collect()
+}
+
+#[test]
+fn sphere_queries_every_lane_equals_one_ray() {
+    let mut rng = SmallRng::seed_from_u64(11);
+    for _ in 0..6 {
+        let s = spheres(&mut rng, 24);
+        let rays: Vec<Ray> = (0..160).map(|_| ray(&mut rng, Vec3::ZERO, 8.0)).collect();
+        let hits = every_width(&s[..], &rays, "spheres");
+        // The same t and index as the existing loop.
+        for (r, h) in rays.iter().zip(&hits) {
+            let old = sphere::closest::<Robust, f32>(&RayPacket::splat(r), &s).get();
+            assert_eq!(
+                old.map(|o| (o.t.to_bits(), o.index)),
+                h.map(|h| (h.t.to_bits(), h.index))
+            );
+        }
+        let n = hits.iter().filter(|h| h.is_some()).count();
+        assert!(n > 20, "{n} sphere hits");
+        every_width(&s.using::<Quadratic>(), &rays, "quadratic");
+        every_width(&s.using::<QuadraticUnit>(), &rays, "quadratic unit");
+        every_width(&s.using::<Geometric>(), &rays, "geometric");
+        every_width(&s.using::<Robust>().culled(Cull::Back), &rays, "culled");
+    }
+}
+
+#[test]
+fn triangle_queries_every_lane_equals_one_ray() {
+    let m = load_bin(include_bytes!("../data/bunny.bin"));
+    let tris: Vec<Triangle> = m
+        .idx
+        .iter()
+        .map(|t| {
+            Triangle::new(
+                m.pos[t[0] as usize],
+                m.pos[t[1] as usize],
+                m.pos[t[2] as usize],
+            )
+        })
+        .collect();
+    let (lo, hi) = m
+        .pos
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
+            (l.min(*p), h.max(*p))
+        });
+    let (c, size) = ((lo + hi) / 2.0, (hi - lo).length() / 2.0);
+    let mut rng = SmallRng::seed_from_u64(12);
+    let mut rays: Vec<Ray> = (0..160).map(|_| ray(&mut rng, c, size)).collect();
+    // Some from inside the body: back faces.
+    rays.extend((0..40).map(|_| Ray::new(c, vec(&mut rng, 1.0))));
+    let hits = every_width(&tris[..], &rays, "watertight");
+    for (r, h) in rays.iter().zip(&hits) {
+        let old =
+            triangle::closest::<Watertight, f32>(&RayPacket::splat(r), &tris, Cull::None).get();
+        let key = |t: f32, u: f32, v: f32, i: u32| (t.to_bits(), u.to_bits(), v.to_bits(), i);
+        assert_eq!(
+            old.map(|o| key(o.t, o.u, o.v, o.index)),
+            h.map(|h| key(h.t, h.u, h.v, h.index))
+        );
+    }
+    let n = hits.iter().filter(|h| h.is_some()).count();
+    assert!(n > 20, "{n} triangle hits");
+    let fronts = hits.iter().flatten().filter(|h| h.front).count();
+    assert!(fronts > 0 && fronts < n, "{fronts} of {n} front faces");
+    every_width(&tris.using::<Moller>(), &rays, "moller");
+    let culled = every_width(
+        &tris.using::<Watertight>().culled(Cull::Back),
+        &rays,
+        "culled",
+    );
+    assert!(culled.iter().flatten().all(|h| h.front));
+}
+
+#[test]
+fn plane_and_scene_queries_every_lane_equals_one_ray() {
+    let mut rng = SmallRng::seed_from_u64(13);
+    let planes: Vec<Plane> = (0..5)
+        .map(|_| Plane::new(vec(&mut rng, 8.0), vec(&mut rng, 2.0)))
+        .collect();
+    let s = spheres(&mut rng, 12);
+    let tris: Vec<Triangle> = (0..12)
+        .map(|_| Triangle::new(vec(&mut rng, 8.0), vec(&mut rng, 8.0), vec(&mut rng, 8.0)))
+        .collect();
+    let rays: Vec<Ray> = (0..160).map(|_| ray(&mut rng, Vec3::ZERO, 8.0)).collect();
+    every_width(&planes[..], &rays, "planes");
+    let scene = (&s[..], &tris[..], &planes[..]);
+    let hits = every_width(&scene, &rays, "scene");
+    // The scene's answer is the closest of its sets' answers (ties to the earlier set).
+    for (r, h) in rays.iter().zip(&hits) {
+        let parts = [s.closest(r), tris.closest(r), planes.closest(r)];
+        let mut want: Option<Hit> = None;
+        for (k, p) in parts.into_iter().enumerate() {
+            if let Some(p) = p
+                && want.is_none_or(|w| p.t < w.t)
+            {
+                want = Some(Hit { set: k as u32, ..p });
+            }
+        }
+        assert_eq!(bits(*h), bits(want), "scene vs sets: {r:?}");
+    }
+    let sets: Vec<u32> = hits.iter().flatten().map(|h| h.set).collect();
+    for k in 0..3 {
+        assert!(sets.contains(&k), "no hit of set {k}");
+    }
+}
