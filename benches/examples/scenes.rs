@@ -21,7 +21,9 @@
 //! ray): hit/miss disagreements and `t` differences beyond 10^-3 relative are counted, and a
 //! contender with more than 10^-4 of its rays differing is reported and not timed.
 //!
-//! Each frame is run `--runs` times (default 5; 3 above 10^5 triangles) and the median kept.
+//! Each frame is run `--runs` times (default 7; 3 above 10^5 triangles), the contenders of one
+//! kind of ray in turn (round robin, so that the machine's load drifts over all of them
+//! alike), and the median kept.
 //! The tables (markdown) go to stdout: scenes, build time and bytes per triangle, rays/s per
 //! kind of ray with the ratio to Embree, rays/s against the triangle count, and the goals.
 
@@ -112,18 +114,6 @@ struct Opts {
     only: Vec<String>,
 }
 
-fn median_secs(runs: usize, f: &dyn Fn() -> u32) -> f64 {
-    let mut t: Vec<f64> = (0..runs)
-        .map(|_| {
-            let s = Instant::now();
-            std::hint::black_box(f());
-            s.elapsed().as_secs_f64()
-        })
-        .collect();
-    t.sort_by(f64::total_cmp);
-    t[t.len() / 2]
-}
-
 /// Compares answers with the reference: (rays differing, largest |Δt|/t where both hit).
 fn check(got: &Answers, want: &Answers) -> (usize, f64) {
     let mut bad = got.len().abs_diff(want.len());
@@ -155,6 +145,7 @@ fn run_jobs(
     runs: usize,
 ) {
     println!("  {} rays (reference: {} rays)", kind.name(), want.len());
+    let mut timed = Vec::new();
     for j in jobs {
         let got = (j.answers)();
         let got: Answers = if j.full {
@@ -165,8 +156,13 @@ fn run_jobs(
         let (bad, worst) = check(&got, want);
         // At most one ray in 10^4 (and at least one) may differ: grazing rays between two
         // triangles, where kernels of different rounding legitimately disagree.
-        let ok = bad <= (want.len() / 10_000).max(1);
-        if !ok {
+        if bad <= (want.len() / 10_000).max(1) {
+            timed.push((
+                j,
+                format!("{bad} differ, max |Δt|/t {worst:.1e}"),
+                Vec::new(),
+            ));
+        } else {
             println!(
                 "    {:<44} {bad} rays differ, max |Δt|/t {worst:.1e}  FAILED: not timed",
                 j.name
@@ -177,12 +173,22 @@ fn run_jobs(
                 j.name,
                 want.len()
             ));
-            continue;
         }
-        let secs = median_secs(runs, &*j.run);
-        let rps = j.rays as f64 / secs;
+    }
+    // Round robin: every contender once per round, so that the machine's load drifts over
+    // all of them alike; the median of the rounds.
+    for _ in 0..runs {
+        for (j, _, secs) in &mut timed {
+            let s = Instant::now();
+            std::hint::black_box((j.run)());
+            secs.push(s.elapsed().as_secs_f64());
+        }
+    }
+    for (j, checked, mut secs) in timed {
+        secs.sort_by(f64::total_cmp);
+        let rps = j.rays as f64 / secs[secs.len() / 2];
         println!(
-            "    {:<44} {bad} differ, max |Δt|/t {worst:.1e}  {:>9} rays/s ({} rays)",
+            "    {:<44} {checked}  {:>9} rays/s ({} rays)",
             j.name,
             si(rps),
             j.rays
@@ -376,7 +382,7 @@ fn thin(rays: &[Ray], stride: usize) -> Vec<Ray> {
 
 fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
     let n = m.len();
-    let runs = opts.runs.unwrap_or(if n > 100_000 { 3 } else { 5 });
+    let runs = opts.runs.unwrap_or(if n > 100_000 { 3 } else { 7 });
     let stride = if n > SAMPLED_ABOVE { STRIDE } else { 1 };
     let name = m.name.clone();
     println!(
