@@ -114,6 +114,12 @@ struct Opts {
     only: Vec<String>,
 }
 
+/// The median of some timings.
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
 /// Compares answers with the reference: (rays differing, largest |Δt|/t where both hit).
 fn check(got: &Answers, want: &Answers) -> (usize, f64) {
     let mut bad = got.len().abs_diff(want.len());
@@ -393,44 +399,41 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
     let cam = meshes::framing(centre, radius);
     let tris = m.triangles();
 
-    // raylane brute force with bounding spheres.
+    // Every structure is built `runs` times, round robin, and the median build time kept
+    // (the last build of each is used).
     let size = rl::part_size(n);
-    let start = Instant::now();
-    let parts = Parts::new(&tris, size);
-    let bounded = parts.meshes();
-    let build = start.elapsed();
-    let bytes = (36 + 12 + 88) as f64 + 20.0 * parts.len() as f64 / n as f64;
     let label_bf = "raylane brute force + spheres".to_string();
-    res.builds.insert(
-        (name.clone(), label_bf.clone()),
-        (build.as_secs_f64(), bytes),
-    );
+    let mut times: [Vec<f64>; 5] = Default::default();
+    let mut built = None;
+    for _ in 0..runs {
+        let start = Instant::now();
+        let parts = Parts::new(&tris, size);
+        times[0].push(start.elapsed().as_secs_f64());
+        let ebr = EmbreeBvh::mesh(m, true);
+        times[1].push(ebr.build.as_secs_f64());
+        let obv = ObvhsBvh::mesh(m);
+        times[2].push(obv.build.as_secs_f64());
+        let par = ParryMesh::new(m);
+        times[3].push(par.build.as_secs_f64());
+        let tree = rl::Tree::mesh(&m.positions, &m.indices);
+        times[4].push(tree.build.as_secs_f64());
+        built = Some((parts, ebr, obv, par, tree));
+    }
+    let (parts, mut ebr, obv, par, tree) = built.expect("at least one run");
+    let [t_bf, t_e, t_o, t_p, t_t] = times.map(median);
+    let bounded = parts.meshes();
     let ids = parts.ids();
-
-    // Peers.
-    let mut ebr = EmbreeBvh::mesh(m, true);
-    res.builds.insert(
-        (name.clone(), "Embree".into()),
-        (
-            ebr.build.as_secs_f64(),
-            ebr.bytes.saturating_sub(ebr.buffer_bytes) as f64 / n as f64,
-        ),
-    );
-    let obv = ObvhsBvh::mesh(m);
-    res.builds.insert(
-        (name.clone(), "obvhs".into()),
-        (obv.build.as_secs_f64(), obv.bytes() as f64 / n as f64),
-    );
-    let par = ParryMesh::new(m);
-    res.builds.insert(
-        (name.clone(), "parry3d".into()),
-        (par.build.as_secs_f64(), f64::NAN),
-    );
-    let tree = rl::Tree::mesh(&m.positions, &m.indices);
-    res.builds.insert(
-        (name.clone(), BVH.into()),
-        (tree.build.as_secs_f64(), tree.bytes() as f64 / n as f64),
-    );
+    let bf_bytes = (36 + 12 + 88) as f64 + 20.0 * parts.len() as f64 / n as f64;
+    let e_bytes = ebr.bytes.saturating_sub(ebr.buffer_bytes) as f64 / n as f64;
+    for (c, v) in [
+        (label_bf.clone(), (t_bf, bf_bytes)),
+        ("Embree".into(), (t_e, e_bytes)),
+        ("obvhs".into(), (t_o, obv.bytes() as f64 / n as f64)),
+        ("parry3d".into(), (t_p, f64::NAN)),
+        (BVH.to_string(), (t_t, tree.bytes() as f64 / n as f64)),
+    ] {
+        res.builds.insert((name.clone(), c), v);
+    }
     let tb = tree.bvh();
 
     // The secondary rays start from Embree's primary hits (checked below like every other
@@ -542,14 +545,28 @@ fn sphere_scene(res: &mut Results, count: usize, opts: &Opts) {
     let (centre, radius) = (Vec3::ZERO, 3f32.sqrt() * (1.0 + r));
     let cam = meshes::framing(centre, radius);
     let primary = Workload::primary(&cam);
-    let mut ebr = EmbreeBvh::spheres(&spheres, true);
-    res.builds.insert(
-        (name.clone(), "Embree".into()),
-        (
-            ebr.build.as_secs_f64(),
-            ebr.bytes.saturating_sub(ebr.buffer_bytes) as f64 / count as f64,
-        ),
-    );
+    let mut times: [Vec<f64>; 3] = Default::default();
+    let mut built = None;
+    for _ in 0..runs {
+        let ebr = EmbreeBvh::spheres(&spheres, true);
+        times[0].push(ebr.build.as_secs_f64());
+        let obv = ObvhsBvh::spheres(&spheres);
+        times[1].push(obv.build.as_secs_f64());
+        let tree = rl::Tree::spheres(&spheres);
+        times[2].push(tree.build.as_secs_f64());
+        built = Some((ebr, obv, tree));
+    }
+    let (mut ebr, obv, tree) = built.expect("at least one run");
+    let [t_e, t_o, t_t] = times.map(median);
+    let e_bytes = ebr.bytes.saturating_sub(ebr.buffer_bytes) as f64 / count as f64;
+    for (c, v) in [
+        ("Embree".to_string(), (t_e, e_bytes)),
+        ("obvhs".into(), (t_o, obv.bytes() as f64 / count as f64)),
+        (BVH.to_string(), (t_t, tree.bytes() as f64 / count as f64)),
+    ] {
+        res.builds.insert((name.clone(), c), v);
+    }
+    let tb = tree.bvh();
     let e_hits = collect(|o| ebr.intersect1(&EmbreeRays::new(&primary), o));
     let hits: Vec<SurfaceHit> = primary
         .iter()
@@ -567,17 +584,6 @@ fn sphere_scene(res: &mut Results, count: usize, opts: &Opts) {
         format!("reference and brute force on every {STRIDE}st ray"),
     ));
     res.order.push((name.clone(), count));
-    let obv = ObvhsBvh::spheres(&spheres);
-    res.builds.insert(
-        (name.clone(), "obvhs".into()),
-        (obv.build.as_secs_f64(), obv.bytes() as f64 / count as f64),
-    );
-    let tree = rl::Tree::spheres(&spheres);
-    res.builds.insert(
-        (name.clone(), BVH.into()),
-        (tree.build.as_secs_f64(), tree.bytes() as f64 / count as f64),
-    );
-    let tb = tree.bvh();
     let keep = Keep::default();
     for kind in [Kind::Primary, Kind::Diffuse, Kind::Shadow] {
         let all: &[Ray] = match kind {
