@@ -11,7 +11,7 @@ use glam::Vec3;
 use raylane::Pinhole;
 use raylane::bvh::{self, Bvh, Node, Scratch, Tri4};
 use raylane::mesh::Mesh;
-use raylane::{Lane, Mask};
+use raylane::{Lane, Mask, Query};
 use wide::{f32x4, f32x8, f32x16};
 
 struct Model {
@@ -103,7 +103,7 @@ fn run<L: Lane<Scalar = f32>>(
 }
 
 fn packet<L: Lane<Scalar = f32>>(tree: &Bvh<Tri4>, cam: &Pinhole) -> (f64, f64) {
-    run::<L>(cam, |p| tree.closest_packet(p).mask.bits().count_ones())
+    run::<L>(cam, |p| tree.closest(p).mask.bits().count_ones())
 }
 
 fn main() {

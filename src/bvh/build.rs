@@ -1,8 +1,8 @@
 //! The binned-SAH builder of 8-wide nodes over caller storage, and the refit.
 
 use super::{
-    BINS, BuildError, Bvh, EMPTY, LEAF, LEAF_WIDTH, Leaf, Node, Primitives, SAH_DEPTH, Scratch,
-    WIDTH, area, max, min, needed, reach,
+    BINS, BuildError, Bvh, EMPTY, LEAF, LEAF_WIDTH, Leaf, MAX_PRIMITIVES, Node, Primitives,
+    SAH_DEPTH, Scratch, WIDTH, area, max, min, needed, reach,
 };
 use crate::triangle::Cull;
 
@@ -122,8 +122,8 @@ fn split(s: &mut [Scratch], depth: u32) -> usize {
 ///
 /// # Errors
 ///
-/// [`BuildError`] when a slice is shorter than [`needed`] gives, or for more than `2^31 − 1`
-/// primitives. Nothing is written to `leaves` beyond the first error.
+/// [`BuildError`] when a slice is shorter than [`needed`] gives, or for more than
+/// [`MAX_PRIMITIVES`]. Nothing is written to `leaves` beyond the first error.
 pub fn build<'s, P: Primitives + ?Sized>(
     prims: &P,
     nodes: &'s mut [Node],
@@ -131,7 +131,7 @@ pub fn build<'s, P: Primitives + ?Sized>(
     scratch: &mut [Scratch],
 ) -> Result<Bvh<'s, P::Leaf>, BuildError> {
     let n = prims.count();
-    if n >= LEAF as usize {
+    if n > MAX_PRIMITIVES {
         return Err(BuildError::TooMany);
     }
     let need = needed(n);

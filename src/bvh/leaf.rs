@@ -5,9 +5,10 @@ use glam::Vec3;
 use wide::f32x4;
 
 use super::{EMPTY, LEAF_WIDTH, max, min};
-use crate::hit::LaneHit;
-use crate::lane::Lane;
+use crate::hit::{Best, LaneHit};
+use crate::lane::{Lane, Mask};
 use crate::mesh::Mesh;
+use crate::query::{Hits, Query, Using, sphere_hit};
 use crate::ray::RayPacket;
 use crate::sphere::{Robust, Sphere, SphereKernel, SpherePacket};
 use crate::triangle::{Cull, Shear, Triangle, TriangleKernel, TrianglePacket, Watertight};
@@ -18,6 +19,26 @@ use crate::vec3::V3;
 pub trait Leaf: Copy + core::fmt::Debug {
     /// A leaf with no primitive.
     const EMPTY: Self;
+    /// The primitive type.
+    type Prim: Copy;
+    /// The primitive in lane `k` (one that is never hit for an unused lane).
+    fn prim(&self, k: usize) -> Self::Prim;
+    /// The query records of the winners in `best` (`prim(i)`: the primitive of index `i`),
+    /// as the flat sets make them ([`Hits::from_triangles`], [`Hits::from_spheres`]).
+    fn records<L: Lane>(
+        rays: &RayPacket<L>,
+        best: &Best<L>,
+        cull: Cull,
+        prim: impl Fn(u32) -> Option<Self::Prim>,
+    ) -> Hits<L>;
+    /// Every hit of `rays` on `prim` (index `index`), as the flat set's `all` reports it.
+    fn all<L: Lane>(
+        prim: &Self::Prim,
+        index: u32,
+        rays: &RayPacket<L>,
+        cull: Cull,
+        f: &mut dyn FnMut(&Hits<L>),
+    );
     /// Per-ray constants of the leaf kernel.
     type Rays<L: Lane>: Copy;
     /// The per-ray constants of `rays`.
@@ -34,7 +55,8 @@ pub trait Leaf: Copy + core::fmt::Debug {
         pre: &Self::Rays<L>,
         cull: Cull,
     ) -> LaneHit<L>;
-    /// 1 ray × 4 primitives: the ray splatted against the leaf's lanes.
+    /// 1 ray × 4 primitives: the ray splatted against the leaf's lanes (the same candidate
+    /// per lane as [`test_one`](Self::test_one)).
     fn test_four(
         &self,
         ray: &RayPacket<f32x4>,
@@ -137,6 +159,34 @@ impl Leaf for Tri4 {
         c: [[f32::NAN; LEAF_WIDTH]; 3],
         index: [EMPTY; LEAF_WIDTH],
     };
+    type Prim = Triangle;
+
+    fn prim(&self, k: usize) -> Triangle {
+        self.triangle(k)
+    }
+
+    #[inline]
+    fn records<L: Lane>(
+        rays: &RayPacket<L>,
+        best: &Best<L>,
+        cull: Cull,
+        prim: impl Fn(u32) -> Option<Triangle>,
+    ) -> Hits<L> {
+        Hits::from_triangles(rays, best, cull, prim)
+    }
+
+    fn all<L: Lane>(
+        prim: &Triangle,
+        index: u32,
+        rays: &RayPacket<L>,
+        cull: Cull,
+        f: &mut dyn FnMut(&Hits<L>),
+    ) {
+        Using::<[Triangle], Watertight>::new(core::slice::from_ref(prim))
+            .culled(cull)
+            .all_packet(rays, &mut |h: &Hits<L>| f(&reindex(h, index)));
+    }
+
     type Rays<L: Lane> = Shear<L>;
 
     #[inline(always)]
@@ -186,6 +236,34 @@ impl Leaf for Sphere4 {
         radius: [f32::NAN; LEAF_WIDTH],
         index: [EMPTY; LEAF_WIDTH],
     };
+    type Prim = Sphere;
+
+    fn prim(&self, k: usize) -> Sphere {
+        Sphere::new(get(&self.center, k), self.radius[k])
+    }
+
+    #[inline]
+    fn records<L: Lane>(
+        rays: &RayPacket<L>,
+        best: &Best<L>,
+        _cull: Cull,
+        prim: impl Fn(u32) -> Option<Sphere>,
+    ) -> Hits<L> {
+        Hits::from_spheres(rays, best, prim)
+    }
+
+    fn all<L: Lane>(
+        prim: &Sphere,
+        index: u32,
+        rays: &RayPacket<L>,
+        cull: Cull,
+        f: &mut dyn FnMut(&Hits<L>),
+    ) {
+        Using::<[Sphere], Robust>::new(core::slice::from_ref(prim))
+            .culled(cull)
+            .all_packet(rays, &mut |h: &Hits<L>| f(&reindex(h, index)));
+    }
+
     type Rays<L: Lane> = ();
 
     #[inline(always)]
@@ -201,22 +279,37 @@ impl Leaf for Sphere4 {
     }
 
     #[inline(always)]
-    fn test_one<L: Lane>(&self, k: usize, rays: &RayPacket<L>, _: &(), _: Cull) -> LaneHit<L> {
+    fn test_one<L: Lane>(&self, k: usize, rays: &RayPacket<L>, _: &(), cull: Cull) -> LaneHit<L> {
         let s = SpherePacket {
             center: V3::splat(get(&self.center, k)),
             radius: L::from_f32(self.radius[k]),
         };
-        Robust::roots(rays, &s).first()
+        sphere_hit(&Robust::roots(rays, &s), cull)
     }
 
     #[inline(always)]
-    fn test_four(&self, ray: &RayPacket<f32x4>, _: &(), _: Cull) -> LaneHit<f32x4> {
+    fn test_four(&self, ray: &RayPacket<f32x4>, _: &(), cull: Cull) -> LaneHit<f32x4> {
         let s = SpherePacket {
             center: lanes4(&self.center),
             radius: f32x4::new(self.radius),
         };
-        Robust::roots(ray, &s).first()
+        sphere_hit(&Robust::roots(ray, &s), cull)
     }
+}
+
+/// `h` with primitive index `index` in every lane that hit (the one-element set's records
+/// carry 0).
+fn reindex<L: Lane>(h: &Hits<L>, index: u32) -> Hits<L> {
+    let mut h = *h;
+    let mut bits = h.mask.bits();
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        if let Some(x) = h.index.as_mut().get_mut(i) {
+            *x = index;
+        }
+    }
+    h
 }
 
 /// `c ± r` (the empty box for an invalid sphere: NaN radius).

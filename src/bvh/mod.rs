@@ -18,8 +18,8 @@
 //!   fused multiply-add) and fixed tie-breaking (lowest axis, lowest bin, lowest slot): the
 //!   same tree, bit for bit, on every target.
 //! * **Bounded depth.** From depth [`SAH_DEPTH`] on, ranges are split at their middle index
-//!   (largest range first), so the depth never exceeds [`MAX_DEPTH`] (for up to `2^31`
-//!   primitives), and the traversal's fixed-size stack ([`STACK`] entries, 2 KB) cannot
+//!   (largest range first), so the depth never exceeds [`MAX_DEPTH`] (for up to
+//!   [`MAX_PRIMITIVES`]), and the traversal's fixed-size stack ([`STACK`] entries, 2 KB) cannot
 //!   overflow; [`Bvh::from_parts`] refuses deeper trees.
 //! * **Bad input.** A primitive that no kernel can hit (NaN or infinite coordinates, zero area,
 //!   non-positive radius) gets an empty box and is never visited; coincident primitives are
@@ -37,15 +37,39 @@
 //!
 //! # Traversal and exactness
 //!
-//! [`Bvh::closest`] / [`Bvh::any`] take one ray (children in lanes: one `f32x8` slab test per
-//! node, nearest child first; leaves with one `f32x4` kernel call), [`Bvh::closest_packet`] /
-//! [`Bvh::any_packet`] / [`Bvh::all_packet`] take a packet of any width (1, 4, 8, 16 rays: one
-//! box per lane operation, inactive lanes masked). Triangles use [`Watertight`](crate::triangle::Watertight), spheres
-//! [`Robust`](crate::sphere::Robust).
+//! A [`Bvh`] implements [`Query`](crate::Query): `closest`, `any`, `all` for one [`Ray`](crate::Ray)
+//! (children in lanes: one `f32x8` slab test per node, nearest child first; leaves with one
+//! `f32x4` kernel call: 1 ray × 4 primitives) or a [`RayPacket`](crate::RayPacket) of any width (1, 4, 8, 16
+//! rays: one child box per lane operation, inactive lanes masked; N rays × 1 primitive in the
+//! leaves). Triangles use [`Watertight`](crate::triangle::Watertight), spheres
+//! [`Robust`](crate::sphere::Robust), two-sided unless [`Bvh::with_cull`] says otherwise.
+//!
+//! ```
+//! use raylane::bvh::{self, Node, Scratch, Tri4, Leaf};
+//! use raylane::glam::Vec3;
+//! use raylane::triangle::Triangle;
+//! use raylane::{Query, Ray};
+//!
+//! let tris: Vec<Triangle> = (0..100)
+//!     .map(|i| {
+//!         let x = i as f32;
+//!         Triangle::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 0.0, 0.0), Vec3::new(x, 1.0, 0.0))
+//!     })
+//!     .collect();
+//! let need = bvh::needed(tris.len());
+//! let mut nodes = vec![Node::EMPTY; need.nodes];
+//! let mut leaves = vec![Tri4::EMPTY; need.leaves];
+//! let mut scratch = vec![Scratch::default(); need.scratch];
+//! let tree = bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch).unwrap();
+//! let ray = Ray::new(Vec3::new(42.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0));
+//! let hit = tree.closest(&ray).unwrap();
+//! assert_eq!((hit.index, hit.t), (42, 1.0));
+//! assert_eq!(Some(hit), tris[..].closest(&ray)); // the flat set's answer, bit for bit
+//! ```
 //!
 //! The closest hit is the one brute force finds with the same kernel: the smallest rounded `t`,
-//! ties to the lowest primitive index, with the same `t`, `u`, `v`, index bits, whatever order
-//! the tree is visited in. Two things make it so:
+//! ties to the lowest primitive index, with the same `t`, `u`, `v`, index bits (and so the same
+//! point, normal and face), whatever order the tree is visited in. Two things make it so:
 //!
 //! 1. **Lexicographic merge.** A candidate wins on `(t, index)`, and `t_max` is relaxed to
 //!    `t + |t|·2^-21` after each hit exactly as the brute-force loops do ([`crate::hit`]), so a
@@ -69,6 +93,7 @@
 
 mod build;
 mod leaf;
+mod query;
 mod traverse;
 
 pub use build::{build, refit};
@@ -86,10 +111,12 @@ pub const BINS: usize = 16;
 pub const SAH_DEPTH: u32 = 24;
 /// The deepest a built tree gets: the root is depth 1; from [`SAH_DEPTH`] on, a node splits
 /// its largest range 7 times at the middle index, so each level divides the largest range by
-/// 8, and `2^31` primitives reach leaves of at most 4 within 10 more levels.
+/// 8, and [`MAX_PRIMITIVES`] reach leaves of at most 4 within 10 more levels.
 pub const MAX_DEPTH: u32 = SAH_DEPTH + 11;
 /// Entries of the traversal stack: at most `WIDTH − 1` siblings wait per level, plus one.
 pub const STACK: usize = (WIDTH - 1) * MAX_DEPTH as usize + 1;
+/// The most primitives a tree holds: `2^30 − 1`.
+pub const MAX_PRIMITIVES: usize = (1 << 30) - 1;
 /// `child[k]` of an unused slot.
 pub const EMPTY: u32 = u32::MAX;
 /// The bit that marks `child[k]` as a leaf index.
@@ -174,7 +201,7 @@ pub enum BuildError {
     Leaves(usize),
     /// Less scratch than [`needed`] gives.
     Scratch(usize),
-    /// More than `2^31 − 1` primitives.
+    /// More than [`MAX_PRIMITIVES`].
     TooMany,
     /// [`refit`]: the leaves do not match the primitives (an index out of range).
     Mismatch,
@@ -186,7 +213,7 @@ impl core::fmt::Display for BuildError {
             BuildError::Nodes(n) => write!(f, "BVH build needs {n} nodes"),
             BuildError::Leaves(n) => write!(f, "BVH build needs {n} leaves"),
             BuildError::Scratch(n) => write!(f, "BVH build needs {n} scratch entries"),
-            BuildError::TooMany => write!(f, "BVH build: more than 2^31 - 1 primitives"),
+            BuildError::TooMany => write!(f, "BVH build: more than 2^30 - 1 primitives"),
             BuildError::Mismatch => write!(f, "BVH refit: leaves do not match the primitives"),
         }
     }

@@ -5,8 +5,10 @@ use glam::Vec3;
 use wide::{f32x4, f32x8};
 
 use super::{Bvh, EMPTY, LEAF, Leaf, Node, STACK, WIDTH};
-use crate::hit::{Hit, HitRecord, LaneHit, relax};
+use crate::hit::{Best, LaneHit, relax};
+use crate::lane::MAX_LANES;
 use crate::lane::{Lane, Mask};
+use crate::query::Hits;
 use crate::ray::{Ray, RayPacket};
 
 /// The box widening relative to `R + |o|∞`: `2^-14`.
@@ -147,21 +149,22 @@ impl Stack {
     }
 }
 
-/// The best hit of one ray so far.
+/// The best hit of one ray so far, and where its primitive sits (leaf, lane).
 #[derive(Clone, Copy, Debug)]
-struct Best {
+struct One {
     t: f32,
     u: f32,
     v: f32,
     w: f32,
     index: u32,
+    leaf: u32,
+    lane: usize,
 }
 
 impl<P: Leaf> Bvh<'_, P> {
-    /// The closest hit of one ray: the brute-force answer with the same kernel, bit for bit
-    /// (see the [module docs](super)).
-    #[must_use]
-    pub fn closest(&self, ray: &Ray) -> Option<HitRecord> {
+    /// The closest hit of one ray (finished, as a one-lane [`Best`]) and its primitive: the
+    /// brute-force answer with the same kernel, bit for bit (see the [module docs](super)).
+    pub(crate) fn closest_one(&self, ray: &Ray) -> Option<(Best<f32>, P::Prim)> {
         if !ray.is_valid() {
             return None;
         }
@@ -170,12 +173,14 @@ impl<P: Leaf> Bvh<'_, P> {
         let pre = P::prepare(&r4);
         let t_end = ray.t_max();
         let mut t_max = relax(t_end);
-        let mut best = Best {
+        let mut best = One {
             t: f32::INFINITY,
             u: 0.0,
             v: 0.0,
             w: 1.0,
             index: EMPTY,
+            leaf: 0,
+            lane: 0,
         };
         let mut stack = Stack::new();
         while let Some((c, tn)) = stack.pop() {
@@ -190,7 +195,8 @@ impl<P: Leaf> Bvh<'_, P> {
                 stack.push_sorted(n, bits, &tn.to_array());
                 continue;
             }
-            let Some(leaf) = self.leaves.get((c & !LEAF) as usize) else {
+            let li = c & !LEAF;
+            let Some(leaf) = self.leaves.get(li as usize) else {
                 continue;
             };
             let r = RayPacket {
@@ -204,28 +210,29 @@ impl<P: Leaf> Bvh<'_, P> {
                 bits &= bits - 1;
                 let (t, index) = (h.t.lane(j), leaf.indices()[j]);
                 if t < t_end && (t < best.t || (t == best.t && index < best.index)) {
-                    best = Best {
+                    best = One {
                         t,
                         u: h.u.lane(j),
                         v: h.v.lane(j),
                         w: h.w.lane(j),
                         index,
+                        leaf: li,
+                        lane: j,
                     };
                     t_max = relax(t);
                 }
             }
         }
-        (best.index != EMPTY).then(|| HitRecord {
-            t: best.t + 0.0,
-            u: best.u / best.w + 0.0,
-            v: best.v / best.w + 0.0,
-            index: best.index,
-        })
+        if best.index == EMPTY {
+            return None;
+        }
+        let prim = self.leaves.get(best.leaf as usize)?.prim(best.lane);
+        let h = LaneHit::deferred(best.t, best.u, best.v, best.w, true);
+        Some((Best::single(&h, best.index), prim))
     }
 
     /// True when one ray hits some primitive (stops at the first hit).
-    #[must_use]
-    pub fn any(&self, ray: &Ray) -> bool {
+    pub(crate) fn any_one(&self, ray: &Ray) -> bool {
         if !ray.is_valid() {
             return false;
         }
@@ -349,14 +356,19 @@ fn lane_f32<L: Lane>(x: L, i: usize) -> f32 {
 }
 
 impl<P: Leaf> Bvh<'_, P> {
-    /// The closest hit of each ray lane: the brute-force answer with the same kernel, bit for
-    /// bit, at every width (see the [module docs](super)).
-    #[must_use]
-    pub fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hit<L> {
+    /// The closest hit of each ray lane (finished) and where each lane's winner sits
+    /// (`4·leaf + lane`): the brute-force answer with the same kernel, bit for bit, at every
+    /// width (see the [module docs](super)).
+    pub(crate) fn closest_lanes<L: Lane>(
+        &self,
+        rays: &RayPacket<L>,
+    ) -> (Best<L>, [u32; MAX_LANES]) {
+        crate::lane::assert_fits::<L>();
         let valid = rays.valid();
-        let mut best = Hit::<L>::none();
+        let mut best = Best::<L>::none();
+        let mut win = [0u32; MAX_LANES];
         if valid.none() {
-            return best;
+            return (best, win);
         }
         let slab = PacketSlab::new(rays, self.reach);
         let pre = P::prepare(rays);
@@ -373,7 +385,8 @@ impl<P: Leaf> Bvh<'_, P> {
                 }
                 continue;
             }
-            let Some(leaf) = self.leaves.get((c & !LEAF) as usize) else {
+            let li = c & !LEAF;
+            let Some(leaf) = self.leaves.get(li as usize) else {
                 continue;
             };
             for (k, &index) in leaf.indices().iter().enumerate() {
@@ -399,15 +412,22 @@ impl<P: Leaf> Bvh<'_, P> {
                 if take.any() {
                     best.take(&h, take, index);
                     r = r.shrink(take, relax(h.t));
+                    let mut bits = take.bits();
+                    while bits != 0 {
+                        let j = bits.trailing_zeros() as usize;
+                        bits &= bits - 1;
+                        if let Some(w) = win.get_mut(j) {
+                            *w = li * 4 + k as u32;
+                        }
+                    }
                 }
             }
         }
-        best.finish()
+        (best.finish(), win)
     }
 
     /// Lanes whose ray hits some primitive (occlusion); stops when every valid lane has hit.
-    #[must_use]
-    pub fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
+    pub(crate) fn any_lanes<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
         let valid = rays.valid();
         let mut hit = L::Mask::splat(false);
         if valid.none() {
@@ -439,10 +459,9 @@ impl<P: Leaf> Bvh<'_, P> {
         hit
     }
 
-    /// Every hit: calls `f(index, hit)` (normalised) for each primitive some lane hits, in
-    /// traversal order (leaves nearest-first by the first lane's entry, lanes of a leaf in
-    /// order). Each primitive is reported at most once.
-    pub fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, mut f: impl FnMut(u32, &LaneHit<L>)) {
+    /// Every hit, as the flat set's `all` reports each primitive's, in traversal order (leaves
+    /// nearest-first by the first lane's entry, lanes of a leaf in order).
+    pub(crate) fn all_lanes<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
         let valid = rays.valid();
         if valid.none() {
             return;
@@ -464,9 +483,8 @@ impl<P: Leaf> Bvh<'_, P> {
                 if index == EMPTY {
                     continue;
                 }
-                let h = leaf.test_one(k, rays, &pre, self.cull);
-                if h.mask.any() {
-                    f(index, &h.normalized());
+                if leaf.test_one(k, rays, &pre, self.cull).mask.any() {
+                    P::all(&leaf.prim(k), index, rays, self.cull, f);
                 }
             }
         }

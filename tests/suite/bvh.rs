@@ -13,9 +13,9 @@ use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bvh::{self, BuildError, Bvh, Leaf, Node, Primitives, Scratch, Sphere4, Tri4};
 use raylane::mesh::Mesh;
-use raylane::sphere::{self, Robust, Sphere};
-use raylane::triangle::{self, Cull, Triangle, Watertight};
-use raylane::{HitRecord, Lane, Mask, Ray, RayPacket};
+use raylane::sphere::{Robust, Sphere};
+use raylane::triangle::{Cull, Triangle, Watertight};
+use raylane::{Hit, Lane, Mask, Query, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
 /// A tree over `p` in owned vectors trimmed to what the build used.
@@ -33,9 +33,24 @@ fn owned<P: Primitives + ?Sized>(p: &P) -> (Vec<Node>, Vec<P::Leaf>) {
     (nodes, leaves)
 }
 
-/// The record's bits (so `-0`/`+0` and NaN payloads would show).
-fn bits(h: Option<HitRecord>) -> Option<[u32; 4]> {
-    h.map(|h| [h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.index])
+/// The record's bits (so `-0`/`+0` would show).
+fn bits(h: Option<Hit>) -> Option<[u32; 12]> {
+    h.map(|h| {
+        [
+            h.t.to_bits(),
+            h.point.x.to_bits(),
+            h.point.y.to_bits(),
+            h.point.z.to_bits(),
+            h.normal.x.to_bits(),
+            h.normal.y.to_bits(),
+            h.normal.z.to_bits(),
+            h.front as u32,
+            h.index,
+            h.set,
+            h.u.to_bits(),
+            h.v.to_bits(),
+        ]
+    })
 }
 
 fn v3(rng: &mut SmallRng, s: f32) -> Vec3 {
@@ -66,114 +81,58 @@ fn rays(rng: &mut SmallRng, n: usize, aim: &[Vec3]) -> Vec<Ray> {
         .collect()
 }
 
-/// Brute force and the BVH on every ray: single-ray `closest`/`any` and packets of 1, 4, 8,
-/// 16 rays, bit for bit. Returns the number of hits.
-fn check<P: Leaf>(
-    bvh: &Bvh<P>,
-    rays: &[Ray],
-    brute: &dyn Fn(&Ray) -> Option<HitRecord>,
-    brute_any: &dyn Fn(&Ray) -> bool,
-    packets: &dyn Fn(&[Ray], &Bvh<P>),
-) -> usize {
+/// Packets of `L` rays: the tree's records equal the flat set's, lane by lane; `any` agrees.
+fn packets_of<L: Lane<Scalar = f32>>(rays: &[Ray], tree: &impl Query, flat: &impl Query) {
+    for (c, chunk) in rays.chunks(L::LANES).enumerate() {
+        let p = RayPacket::<L>::from_rays(chunk);
+        let want = flat.closest(&p);
+        let got = tree.closest(&p);
+        for i in 0..L::LANES {
+            assert_eq!(
+                bits(got.lane(i)),
+                bits(want.lane(i)),
+                "{} lanes, packet {c}, lane {i}: {:?}",
+                L::LANES,
+                chunk.get(i)
+            );
+        }
+        assert_eq!(tree.any(&p).bits(), flat.any(&p).bits());
+    }
+}
+
+/// The tree against the flat set on every ray: one-ray `closest`/`any` and packets of 1, 4,
+/// 8, 16 rays, bit for bit. Returns the number of hits.
+fn check(tree: &impl Query, flat: &impl Query, rays: &[Ray]) -> usize {
     let mut hits = 0;
     for (i, r) in rays.iter().enumerate() {
-        let want = brute(r);
+        let want = flat.closest(r);
         hits += want.is_some() as usize;
-        assert_eq!(bits(bvh.closest(r)), bits(want), "ray {i}: {r:?}");
-        assert_eq!(bvh.any(r), brute_any(r), "any, ray {i}: {r:?}");
+        assert_eq!(bits(tree.closest(r)), bits(want), "ray {i}: {r:?}");
+        assert_eq!(tree.any(r), flat.any(r), "any, ray {i}: {r:?}");
     }
-    packets(rays, bvh);
+    packets_of::<f32>(rays, tree, flat);
+    packets_of::<f32x4>(rays, tree, flat);
+    packets_of::<f32x8>(rays, tree, flat);
+    packets_of::<f32x16>(rays, tree, flat);
     hits
-}
-
-macro_rules! packet_check {
-    ($name:ident, $brute:expr, $brute_any:expr) => {
-        fn $name<P: Leaf, L: Lane<Scalar = f32>>(rays: &[Ray], bvh: &Bvh<P>, ctx: &Ctx) {
-            for (c, chunk) in rays.chunks(L::LANES).enumerate() {
-                let p = RayPacket::<L>::from_rays(chunk);
-                let want = $brute(ctx, &p);
-                let got = bvh.closest_packet(&p);
-                for i in 0..L::LANES {
-                    assert_eq!(
-                        bits(got.lane(i)),
-                        bits(want.lane(i)),
-                        "{} lanes, packet {c}, lane {i}: {:?}",
-                        L::LANES,
-                        chunk.get(i)
-                    );
-                }
-                let want_any: L::Mask = $brute_any(ctx, &p);
-                assert_eq!(bvh.any_packet(&p).bits(), want_any.bits());
-            }
-        }
-    };
-}
-
-/// What the brute-force packet checks run over.
-enum Ctx<'a> {
-    Tris(&'a [Triangle]),
-    Mesh(Mesh<'a>),
-    Spheres(&'a [Sphere]),
-}
-
-fn brute_packet<L: Lane>(ctx: &Ctx, p: &RayPacket<L>) -> raylane::hit::Hit<L> {
-    match ctx {
-        Ctx::Tris(t) => triangle::closest::<Watertight, L>(p, t, Cull::None),
-        Ctx::Mesh(m) => m.closest::<Watertight, L>(p, Cull::None),
-        Ctx::Spheres(s) => sphere::closest::<Robust, L>(p, s),
-    }
-}
-
-fn brute_any_packet<L: Lane>(ctx: &Ctx, p: &RayPacket<L>) -> L::Mask {
-    match ctx {
-        Ctx::Tris(t) => triangle::any::<Watertight, L>(p, t, Cull::None),
-        Ctx::Mesh(m) => m.any::<Watertight, L>(p, Cull::None),
-        Ctx::Spheres(s) => sphere::any::<Robust, L>(p, s),
-    }
-}
-
-packet_check!(packets_of, brute_packet, brute_any_packet);
-
-fn all_widths<P: Leaf>(rays: &[Ray], bvh: &Bvh<P>, ctx: &Ctx) {
-    packets_of::<P, f32>(rays, bvh, ctx);
-    packets_of::<P, f32x4>(rays, bvh, ctx);
-    packets_of::<P, f32x8>(rays, bvh, ctx);
-    packets_of::<P, f32x16>(rays, bvh, ctx);
-}
-
-fn scalar(ctx: &Ctx, r: &Ray) -> Option<HitRecord> {
-    brute_packet::<f32>(ctx, &RayPacket::splat(r)).get()
-}
-
-fn scalar_any(ctx: &Ctx, r: &Ray) -> bool {
-    brute_any_packet::<f32>(ctx, &RayPacket::splat(r))
 }
 
 /// Checks a triangle set against brute force on `rays`; returns the hit count.
 fn check_tris(tris: &[Triangle], rays: &[Ray]) -> usize {
     let (nodes, leaves) = owned(tris);
     let tree = Bvh::from_parts(&nodes, &leaves).expect("a valid tree");
-    let ctx = Ctx::Tris(tris);
-    check(
-        &tree,
-        rays,
-        &|r| scalar(&ctx, r),
-        &|r| scalar_any(&ctx, r),
-        &|rs, b| all_widths(rs, b, &ctx),
-    )
+    check(&tree, &tris, rays)
 }
 
 fn check_spheres(spheres: &[Sphere], rays: &[Ray]) -> usize {
     let (nodes, leaves) = owned(spheres);
     let tree = Bvh::from_parts(&nodes, &leaves).expect("a valid tree");
-    let ctx = Ctx::Spheres(spheres);
-    check(
-        &tree,
-        rays,
-        &|r| scalar(&ctx, r),
-        &|r| scalar_any(&ctx, r),
-        &|rs, b| all_widths(rs, b, &ctx),
-    )
+    check(&tree, &spheres, rays)
+}
+
+/// A mesh's triangles as a flat set (the reference).
+fn flat(mesh: &Mesh) -> Vec<Triangle> {
+    (0..mesh.len()).map(|i| mesh.triangle(i).unwrap()).collect()
 }
 
 fn soup(rng: &mut SmallRng, n: usize) -> Vec<Triangle> {
@@ -201,6 +160,13 @@ fn random_triangle_soups_equal_brute_force() {
         let rs = rays(&mut rng, 800, &centroids(&tris));
         let hits = check_tris(&tris, &rs);
         assert!(hits > 100, "{n} triangles: only {hits} hits");
+        // Front faces only.
+        let (nodes, leaves) = owned(&tris[..]);
+        let tree = Bvh::from_parts(&nodes, &leaves)
+            .unwrap()
+            .with_cull(Cull::Back);
+        let culled = tris[..].using::<Watertight>().culled(Cull::Back);
+        assert!(check(&tree, &culled, &rs[..200]) > 20);
     }
 }
 
@@ -215,6 +181,12 @@ fn random_sphere_sets_equal_brute_force() {
         let rs = rays(&mut rng, 800, &aim);
         let hits = check_spheres(&spheres, &rs);
         assert!(hits > 100, "{n} spheres: only {hits} hits");
+        let (nodes, leaves) = owned(&spheres[..]);
+        let tree = Bvh::from_parts(&nodes, &leaves)
+            .unwrap()
+            .with_cull(Cull::Back);
+        let culled = spheres[..].using::<Robust>().culled(Cull::Back);
+        assert!(check(&tree, &culled, &rs[..200]) > 20);
     }
 }
 
@@ -238,14 +210,8 @@ fn vendored_bunny_equals_brute_force() {
             rs.push(Ray::new(eye, target - eye));
         }
     }
-    let ctx = Ctx::Mesh(mesh);
-    let hits = check(
-        &tree,
-        &rs,
-        &|r| scalar(&ctx, r),
-        &|r| scalar_any(&ctx, r),
-        &|rs, b| all_widths(rs, b, &ctx),
-    );
+    let tris = flat(&mesh);
+    let hits = check(&tree, &&tris[..], &rs);
     assert!(hits > 500, "{hits} hits");
     let s = tree.stats();
     assert_eq!(s.primitives, m.idx.len());
@@ -261,29 +227,22 @@ fn watertight_sets_no_leaks_through_the_tree() {
         let (nodes, leaves) = owned(&mesh);
         let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
         let cases = crate::watertight::cases(s, 7 + si as u64);
+        let tris = flat(&mesh);
         let mut leaks = 0;
         for c in &cases {
-            let p = RayPacket::<f32>::splat(&c.ray);
             let mut want = Vec::new();
-            mesh.all::<Watertight, f32>(&p, Cull::None, |i, h| {
-                want.push((i, h.t.to_bits(), h.u.to_bits(), h.v.to_bits()))
-            });
+            tris[..].all(&c.ray, |h| want.push(bits(Some(h)).unwrap()));
             let mut got = Vec::new();
-            tree.all_packet(&p, |i, h| {
-                got.push((i, h.t.to_bits(), h.u.to_bits(), h.v.to_bits()))
-            });
+            tree.all(&c.ray, |h| got.push(bits(Some(h)).unwrap()));
             want.sort();
             got.sort();
             assert_eq!(got, want, "{:?}", c.ray);
             // Crossings: distinct t (relative gap 1e-5) must reach the expected count.
-            let mut ts: Vec<f32> = got.iter().map(|g| f32::from_bits(g.1)).collect();
+            let mut ts: Vec<f32> = got.iter().map(|g| f32::from_bits(g[0])).collect();
             ts.sort_by(f32::total_cmp);
             ts.dedup_by(|b, a| (*b - *a) <= 1e-5 * a.abs().max(1e-3));
             leaks += (ts.len() < c.crossings) as usize;
-            assert_eq!(
-                bits(tree.closest(&c.ray)),
-                bits(mesh.closest::<Watertight, f32>(&p, Cull::None).get())
-            );
+            assert_eq!(bits(tree.closest(&c.ray)), bits(tris[..].closest(&c.ray)));
         }
         assert_eq!(leaks, 0, "shape {si}");
     }
@@ -520,14 +479,8 @@ fn refit_after_moving_vertices() {
             Ray::new(o, aim[(i * 13) % aim.len()] - o)
         })
         .collect();
-    let ctx = Ctx::Mesh(mesh);
-    let hits = check(
-        &tree,
-        &rs,
-        &|r| scalar(&ctx, r),
-        &|r| scalar_any(&ctx, r),
-        &|rs, b| packets_of::<Tri4, f32x8>(rs, b, &ctx),
-    );
+    let tris = flat(&mesh);
+    let hits = check(&tree, &&tris[..], &rs);
     assert!(hits > 500);
 }
 
@@ -563,7 +516,7 @@ fn depth_is_bounded_and_ties_go_to_the_lowest_index() {
     let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0));
     assert_eq!(tree.closest(&ray).unwrap().index, 0);
     let p = RayPacket::<f32x8>::splat(&ray);
-    assert_eq!(tree.closest_packet(&p).lane(5).unwrap().index, 0);
+    assert_eq!(tree.closest(&p).lane(5).unwrap().index, 0);
 
     let row: Vec<Triangle> = (0..400)
         .map(|i| {
