@@ -21,7 +21,7 @@ use raylane::bvh::{self, Bvh, Leaf, Node, Primitives, Scratch, Sphere4, Tri4};
 use raylane::mesh::{FocalMesh, Mesh};
 use raylane::sphere::{self, Robust, Sphere};
 use raylane::triangle::{Cull, Watertight};
-use raylane::{Lane, Mask, Ray, RayPacket};
+use raylane::{Lane, Mask, Query, Ray, RayPacket};
 
 use crate::meshes::Answers;
 

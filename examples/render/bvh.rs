@@ -17,7 +17,7 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use raylane::bvh::{self, Node, Scratch, Tri4, TriangleBvh};
 use raylane::triangle::Triangle;
-use raylane::{Lane, Pinhole, Ray, RayPacket};
+use raylane::{Lane, Pinhole, Query, Ray, RayPacket};
 
 use super::subdivide;
 
