@@ -128,7 +128,7 @@ fn main() {
         let mesh = Mesh::new(&m.pos, &m.idx);
         let need = bvh::needed(m.idx.len());
         let mut nodes = vec![Node::EMPTY; need.nodes];
-        let mut leaves = vec![<Tri4 as bvh::Leaf>::EMPTY; need.leaves];
+        let mut leaves = vec![<Tri4 as bvh::Packed>::EMPTY; need.leaves];
         let mut scratch = vec![Scratch::default(); need.scratch];
         let mut build_s = f64::INFINITY;
         let mut used = (0, 0);

@@ -1,7 +1,7 @@
 //! The binned-SAH builder of 8-wide nodes over caller storage, and the refit.
 
 use super::{
-    BINS, BuildError, Bvh, EMPTY, LEAF, LEAF_WIDTH, Leaf, MAX_PRIMITIVES, Node, Primitives,
+    BINS, BuildError, Bvh, EMPTY, LEAF, LEAF_WIDTH, MAX_PRIMITIVES, Node, Packed, Primitives,
     SAH_DEPTH, Scratch, WIDTH, area, max, min, needed, reach,
 };
 use crate::triangle::Cull;

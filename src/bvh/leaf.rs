@@ -14,11 +14,20 @@ use crate::sphere::{Robust, Sphere, SphereKernel, SpherePacket};
 use crate::triangle::{Cull, Shear, Triangle, TriangleKernel, TrianglePacket, Watertight};
 use crate::vec3::V3;
 
-/// A leaf: up to [`LEAF_WIDTH`] primitives in lanes, with their indices in the set the tree
-/// was built over ([`EMPTY`] in unused lanes, whose geometry is NaN and never hit).
-pub trait Leaf: Copy + core::fmt::Debug {
+/// What the builder and the refit need of a leaf: up to [`LEAF_WIDTH`] primitives (or
+/// instances) in lanes, their indices in the set the tree was built over ([`EMPTY`] in unused
+/// lanes), and their boxes.
+pub trait Packed: Copy + core::fmt::Debug {
     /// A leaf with no primitive.
     const EMPTY: Self;
+    /// Original indices of the primitives in the lanes.
+    fn indices(&self) -> &[u32; LEAF_WIDTH];
+    /// The box of lane `k` (empty — `min > max` — for a primitive that is never hit).
+    fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]);
+}
+
+/// A leaf of primitives with their kernels (unused lanes hold NaN geometry, never hit).
+pub trait Leaf: Packed {
     /// The primitive type.
     type Prim: Copy;
     /// The primitive in lane `k` (one that is never hit for an unused lane).
@@ -43,10 +52,6 @@ pub trait Leaf: Copy + core::fmt::Debug {
     type Rays<L: Lane>: Copy;
     /// The per-ray constants of `rays`.
     fn prepare<L: Lane>(rays: &RayPacket<L>) -> Self::Rays<L>;
-    /// Original indices of the primitives in the lanes.
-    fn indices(&self) -> &[u32; LEAF_WIDTH];
-    /// The box of lane `k` (empty — `min > max` — for a primitive that is never hit).
-    fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]);
     /// N rays × 1 primitive: lane `k`'s primitive splatted against the rays.
     fn test_one<L: Lane>(
         &self,
@@ -68,7 +73,7 @@ pub trait Leaf: Copy + core::fmt::Debug {
 /// A set of primitives a tree can be built over.
 pub trait Primitives {
     /// The leaf type the primitives are packed into.
-    type Leaf: Leaf;
+    type Leaf: Packed;
     /// Number of primitives.
     fn count(&self) -> usize;
     /// The box of primitive `i` (empty for a primitive that is never hit).
@@ -121,7 +126,7 @@ fn lanes4(v: &[[f32; LEAF_WIDTH]; 3]) -> V3<f32x4> {
 }
 
 /// The box of points, NaN coordinates ignored (all NaN: the empty box).
-fn points_box(p: &[Vec3]) -> ([f32; 3], [f32; 3]) {
+pub(crate) fn points_box(p: &[Vec3]) -> ([f32; 3], [f32; 3]) {
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
     for v in p {
@@ -152,13 +157,25 @@ impl Tri4 {
     }
 }
 
-impl Leaf for Tri4 {
+impl Packed for Tri4 {
     const EMPTY: Self = Tri4 {
         a: [[f32::NAN; LEAF_WIDTH]; 3],
         b: [[f32::NAN; LEAF_WIDTH]; 3],
         c: [[f32::NAN; LEAF_WIDTH]; 3],
         index: [EMPTY; LEAF_WIDTH],
     };
+
+    #[inline(always)]
+    fn indices(&self) -> &[u32; LEAF_WIDTH] {
+        &self.index
+    }
+
+    fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]) {
+        points_box(&[get(&self.a, k), get(&self.b, k), get(&self.c, k)])
+    }
+}
+
+impl Leaf for Tri4 {
     type Prim = Triangle;
 
     fn prim(&self, k: usize) -> Triangle {
@@ -195,15 +212,6 @@ impl Leaf for Tri4 {
     }
 
     #[inline(always)]
-    fn indices(&self) -> &[u32; LEAF_WIDTH] {
-        &self.index
-    }
-
-    fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]) {
-        points_box(&[get(&self.a, k), get(&self.b, k), get(&self.c, k)])
-    }
-
-    #[inline(always)]
     fn test_one<L: Lane>(
         &self,
         k: usize,
@@ -230,12 +238,24 @@ impl Leaf for Tri4 {
     }
 }
 
-impl Leaf for Sphere4 {
+impl Packed for Sphere4 {
     const EMPTY: Self = Sphere4 {
         center: [[f32::NAN; LEAF_WIDTH]; 3],
         radius: [f32::NAN; LEAF_WIDTH],
         index: [EMPTY; LEAF_WIDTH],
     };
+
+    #[inline(always)]
+    fn indices(&self) -> &[u32; LEAF_WIDTH] {
+        &self.index
+    }
+
+    fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]) {
+        sphere_box(&Sphere::new(get(&self.center, k), self.radius[k]))
+    }
+}
+
+impl Leaf for Sphere4 {
     type Prim = Sphere;
 
     fn prim(&self, k: usize) -> Sphere {
@@ -268,15 +288,6 @@ impl Leaf for Sphere4 {
 
     #[inline(always)]
     fn prepare<L: Lane>(_rays: &RayPacket<L>) {}
-
-    #[inline(always)]
-    fn indices(&self) -> &[u32; LEAF_WIDTH] {
-        &self.index
-    }
-
-    fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]) {
-        sphere_box(&Sphere::new(get(&self.center, k), self.radius[k]))
-    }
 
     #[inline(always)]
     fn test_one<L: Lane>(&self, k: usize, rays: &RayPacket<L>, _: &(), cull: Cull) -> LaneHit<L> {

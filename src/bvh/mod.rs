@@ -26,6 +26,12 @@
 //!   split by index; nothing panics or loops.
 //! * [`refit`] recomputes every box after vertices move (same topology, same leaves).
 //!
+//! # Scenes
+//!
+//! [`Scene`] places objects (trees over a mesh or a sphere set) by affine transforms under a
+//! top-level tree of [`Inst4`] leaves; a query returns the closest hit over the scene with
+//! the instance id in [`Hit::set`](crate::Hit::set) (see [`scene`]).
+//!
 //! # Layout (plain data, `#[repr(C)]`)
 //!
 //! A tree is two slices: `nodes` ([`Node`], 224 bytes, root at index 0) and `leaves`
@@ -45,7 +51,7 @@
 //! [`Robust`](crate::sphere::Robust), two-sided unless [`Bvh::with_cull`] says otherwise.
 //!
 //! ```
-//! use raylane::bvh::{self, Node, Scratch, Tri4, Leaf};
+//! use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
 //! use raylane::glam::Vec3;
 //! use raylane::triangle::Triangle;
 //! use raylane::{Query, Ray};
@@ -94,10 +100,12 @@
 mod build;
 mod leaf;
 mod query;
+pub mod scene;
 mod traverse;
 
 pub use build::{build, refit};
-pub use leaf::{Leaf, Primitives, Sphere4, Tri4};
+pub use leaf::{Leaf, Packed, Primitives, Sphere4, Tri4};
+pub use scene::{Inst4, Instance, Scene};
 
 use crate::triangle::Cull;
 
@@ -221,7 +229,7 @@ impl core::fmt::Display for BuildError {
 
 /// A built hierarchy: nodes and leaves borrowed from the caller.
 #[derive(Clone, Copy, Debug)]
-pub struct Bvh<'s, P: Leaf> {
+pub struct Bvh<'s, P: Packed> {
     pub(crate) nodes: &'s [Node],
     pub(crate) leaves: &'s [P],
     /// The largest coordinate magnitude of the root's children (`R` in the margin).
@@ -234,7 +242,7 @@ pub type TriangleBvh<'s> = Bvh<'s, Tri4>;
 /// A BVH over spheres ([`Robust`](crate::sphere::Robust) kernel).
 pub type SphereBvh<'s> = Bvh<'s, Sphere4>;
 
-impl<'s, P: Leaf> Bvh<'s, P> {
+impl<'s, P: Packed> Bvh<'s, P> {
     /// Reopens a tree from its two slices (e.g. `static` data built on a host). Returns `None`
     /// when the slices are not a tree as [`build`] makes them: no nodes, a child index out of
     /// range, an inner child not after its parent, a node reached twice, or a depth above

@@ -24,7 +24,7 @@ const D_HI: f32 = 1.8446744e19;
 /// The per-ray constants of the slab test, for one ray: which plane is near on each axis
 /// (index into [`Node::bounds`]), the two widened origins and the clamped inverse direction.
 #[derive(Clone, Copy, Debug)]
-struct Slab {
+pub(crate) struct Slab {
     near: [usize; 3],
     far: [usize; 3],
     on: [f32; 3],
@@ -35,7 +35,7 @@ struct Slab {
 }
 
 impl Slab {
-    fn new(o: Vec3, d: Vec3, reach: f32) -> Self {
+    pub(crate) fn new(o: Vec3, d: Vec3, reach: f32) -> Self {
         let (o, d) = (o.to_array(), d.to_array());
         let omax = o[0].abs().max(o[1].abs()).max(o[2].abs());
         let dmax = d[0].abs().max(d[1].abs()).max(d[2].abs());
@@ -71,7 +71,7 @@ impl Slab {
     /// Bit `k` set when the ray's interval `(t_min, t_max)` meets child `k`'s widened box; the
     /// entry parameters per child.
     #[inline(always)]
-    fn test(&self, n: &Node, t_min: f32, t_max: f32) -> (u32, f32x8) {
+    pub(crate) fn test(&self, n: &Node, t_min: f32, t_max: f32) -> (u32, f32x8) {
         if self.all {
             let mut bits = 0;
             for (k, &c) in n.child.iter().enumerate() {
@@ -97,7 +97,7 @@ impl Slab {
 
 /// The traversal stack: node references with the entry parameter of their box (the root
 /// first, with `−inf`).
-struct Stack {
+pub(crate) struct Stack {
     node: [u32; STACK],
     tn: [f32; STACK],
     len: usize,
@@ -105,7 +105,7 @@ struct Stack {
 
 impl Stack {
     #[inline(always)]
-    fn new() -> Self {
+    pub(crate) fn new() -> Self {
         let mut s = Stack {
             node: [0; STACK],
             tn: [0.0; STACK],
@@ -116,14 +116,14 @@ impl Stack {
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, f32)> {
+    pub(crate) fn pop(&mut self) -> Option<(u32, f32)> {
         self.len = self.len.checked_sub(1)?;
         Some((*self.node.get(self.len)?, *self.tn.get(self.len)?))
     }
 
     /// Pushes the children in `bits` farthest first (so the nearest is popped first).
     #[inline(always)]
-    fn push_sorted(&mut self, n: &Node, mut bits: u32, tn: &[f32; WIDTH]) {
+    pub(crate) fn push_sorted(&mut self, n: &Node, mut bits: u32, tn: &[f32; WIDTH]) {
         let mut list = [(0u32, 0.0f32); WIDTH];
         let mut m = 0;
         while bits != 0 {
