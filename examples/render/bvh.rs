@@ -103,7 +103,7 @@ impl Tree {
         let start = Instant::now();
         let need = bvh::needed(tris.len());
         let mut nodes = vec![Node::EMPTY; need.nodes];
-        let mut leaves = vec![<Tri4 as bvh::Leaf>::EMPTY; need.leaves];
+        let mut leaves = vec![<Tri4 as bvh::Packed>::EMPTY; need.leaves];
         let mut scratch = vec![Scratch::default(); need.scratch];
         let (n, l) = {
             let t = bvh::build(tris, &mut nodes, &mut leaves, &mut scratch)?;
