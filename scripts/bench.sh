@@ -2,10 +2,13 @@
 # raylane's benchmarks: side by side with its peers, every kernel at every lane width, and the
 # deterministic instruction counts (x86-64-v3 under callgrind, Cortex-M4F under QEMU).
 #
-#   ./scripts/bench.sh              all of it (about 15 minutes on 2 cores, builds included)
+#   ./scripts/bench.sh              all of it (about 25 minutes on 2 cores, builds included)
 #   ./scripts/bench.sh compare      raylane, parry3d, bevy, obvhs and Embree on the same scenes
 #   ./scripts/bench.sh kernels      every kernel × lane width × scene
 #   ./scripts/bench.sh counts       instructions per test: x86-64-v3 and Cortex-M4F
+#   ./scripts/bench.sh scenes       meshes of 10^3..10^6 triangles and 10^5 spheres: primary,
+#                                   diffuse and shadow rays; Embree, obvhs, parry3d, raylane
+#                                   (a plain timed example, medians of a few runs; ~10 minutes)
 #
 # Installs what it needs on Debian (libembree-dev for Embree, valgrind, QEMU and the ARM
 # binutils for the counts). The timed benches are built for the machine they run on
@@ -35,14 +38,21 @@ timed() { # timed NAME ARGS...: one criterion bench, its summary kept in target/
   sed -n '/^## /,$p' "$out/$name.log" > "$out/$name.md"
 }
 
+scenes() { # the BVH benchmark (benches/examples/scenes.rs), its tables kept in target/bench/scenes.md
+  RUSTFLAGS="-C target-cpu=native" cargo run --quiet --release -p raylane-bench --features peers \
+    --target-dir "$root/target/bench-native" --example scenes -- "$@" | tee "$out/scenes.log"
+  sed -n '/^## /,$p' "$out/scenes.log" > "$out/scenes.md"
+}
+
 case $what in
   all | compare) timed compare --features peers ;;&
+  all | scenes) shift || true; scenes "$@" ;;&
   all | kernels) timed kernels ;;&
   all | counts)
     "$root/scripts/count-x86.sh" | tee "$out/count-x86-64-v3.md"
     "$root/scripts/count-m4f.sh" | tee "$out/count-cortex-m4f.md"
     ;;
-  all | compare | kernels) ;;
-  *) echo "usage: $0 [all|compare|kernels|counts]" >&2; exit 2 ;;
+  all | compare | kernels | scenes) ;;
+  *) echo "usage: $0 [all|compare|kernels|counts|scenes [--only NAME]...]" >&2; exit 2 ;;
 esac
 echo "summaries: $out/*.md"

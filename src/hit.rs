@@ -187,7 +187,7 @@ impl<L: Lane> Best<L> {
 
     /// Takes the hits of `h` in the lanes of `take` for primitive `index`.
     #[inline(always)]
-    fn take(&mut self, h: &LaneHit<L>, take: L::Mask, index: u32) {
+    pub(crate) fn take(&mut self, h: &LaneHit<L>, take: L::Mask, index: u32) {
         self.t = L::select(take, h.t, self.t);
         self.u = L::select(take, h.u, self.u);
         self.v = L::select(take, h.v, self.v);
@@ -199,7 +199,7 @@ impl<L: Lane> Best<L> {
     /// Divides the winners' barycentrics by their denominators (once per ray), with `−0`
     /// made `+0` in `t`, `u`, `v` (`x + 0`).
     #[inline(always)]
-    fn finish(mut self) -> Self {
+    pub(crate) fn finish(mut self) -> Self {
         self.t = plus_zero(self.t);
         self.u = plus_zero(self.u / self.w);
         self.v = plus_zero(self.v / self.w);

@@ -54,6 +54,7 @@
 #![forbid(unsafe_op_in_unsafe_fn)]
 
 pub mod bounds;
+pub mod bvh;
 pub mod camera;
 #[cfg(feature = "demo")]
 pub mod demo;

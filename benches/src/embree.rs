@@ -24,11 +24,11 @@ const _: () = assert!(align_of::<Valid8>() == 32 && align_of::<RayHit8>() == 32)
 /// Flush-to-zero and denormals-are-zero while it lives, as Embree asks of every thread that
 /// calls it ("can have a severe performance impact" otherwise); the previous MXCSR comes back
 /// on drop, so raylane and the other peers run with IEEE denormals.
-struct FlushDenormals(u32);
+pub(crate) struct FlushDenormals(u32);
 
 impl FlushDenormals {
     #[allow(deprecated)] // _mm_getcsr/_mm_setcsr: still the plain way to save and restore MXCSR
-    fn on() -> Self {
+    pub(crate) fn on() -> Self {
         // SAFETY: reads this thread's MXCSR (SSE2 is baseline).
         let old = unsafe { std::arch::x86_64::_mm_getcsr() };
         embree3::enable_ftz_and_daz();

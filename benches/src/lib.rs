@@ -23,9 +23,14 @@ use raylane::triangle::focal as tf;
 use raylane::triangle::{self, Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
 use raylane::{HitRecord, Lane, Mask, Pinhole, Ray, RayPacket};
 
+pub mod bvh_raylane;
+pub mod meshes;
 pub mod parts;
 pub mod scene;
+pub mod subdivide;
 
+#[cfg(feature = "peers")]
+pub mod bvh_peers;
 #[cfg(feature = "peers")]
 pub mod embree;
 #[cfg(feature = "peers")]

@@ -20,6 +20,8 @@ use raylane::{Lane, Mask, RayPacket};
 pub struct Parts {
     positions: Vec<Vec<Vec3>>,
     indices: Vec<Vec<[u32; 3]>>,
+    /// The input index of each part's triangles.
+    ids: Vec<Vec<u32>>,
 }
 
 impl Parts {
@@ -32,8 +34,10 @@ impl Parts {
         let mut parts = Parts {
             positions: Vec::new(),
             indices: Vec::new(),
+            ids: Vec::new(),
         };
         for g in groups {
+            parts.ids.push(g.iter().map(|&i| i as u32).collect());
             let mut pos = Vec::with_capacity(3 * g.len());
             let mut idx = Vec::with_capacity(g.len());
             for i in g {
@@ -55,6 +59,20 @@ impl Parts {
     /// True when there are no parts.
     pub fn is_empty(&self) -> bool {
         self.indices.is_empty()
+    }
+
+    /// The input index of each part's triangles (`ids()[p][i]` for triangle `i` of part `p`).
+    pub fn ids(&self) -> &[Vec<u32>] {
+        &self.ids
+    }
+
+    /// The parts as meshes with their bounding spheres (Ritter), for rays from anywhere.
+    pub fn meshes(&self) -> Vec<Mesh<'_>> {
+        self.positions
+            .iter()
+            .zip(&self.indices)
+            .map(|(p, i)| Mesh::bounded(p, i))
+            .collect()
     }
 
     /// Storage for the focal caches of every part.

@@ -23,10 +23,10 @@ use raylane::sphere::focal::FocalKernel;
 use raylane::triangle::{Cull, FocalRays, FocalTriangle, TriangleKernel};
 use raylane::{Ray, RayPacket};
 
-struct Shape {
+pub(crate) struct Shape {
     name: &'static str,
-    pos: Vec<Vec3>,
-    idx: Vec<[u32; 3]>,
+    pub(crate) pos: Vec<Vec3>,
+    pub(crate) idx: Vec<[u32; 3]>,
     center: Vec3,
     size: f32,
 }
@@ -159,9 +159,9 @@ enum Target {
 }
 
 /// A ray and the number of surface crossings it must report.
-struct Case {
-    ray: Ray,
-    crossings: usize,
+pub(crate) struct Case {
+    pub(crate) ray: Ray,
+    pub(crate) crossings: usize,
     target: Target,
     axis: bool,
 }
@@ -205,7 +205,7 @@ fn targets(s: &Shape, rng: &mut SmallRng) -> Vec<(Vec3, Target)> {
     out
 }
 
-fn cases(s: &Shape, seed: u64) -> Vec<Case> {
+pub(crate) fn cases(s: &Shape, seed: u64) -> Vec<Case> {
     let mut rng = SmallRng::seed_from_u64(seed);
     let mut out = Vec::new();
     for (p, target) in targets(s, &mut rng) {
@@ -331,7 +331,7 @@ pub struct Tally {
 }
 
 /// The closed meshes of the test: an icosphere, a cube and a double cone.
-fn shapes() -> [Shape; 3] {
+pub(crate) fn shapes() -> [Shape; 3] {
     [icosphere(4), cube(), double_cone()]
 }
 

@@ -1,0 +1,880 @@
+//! The BVH benchmark of issue 14: meshes of 10^3 to 10^6 triangles and a field of 10^5
+//! spheres, traced by every contender with the same rays in one run, single thread.
+//!
+//! ```text
+//! RUSTFLAGS="-C target-cpu=native" cargo run --release -p raylane-bench --features peers \
+//!     --example scenes [-- --runs N] [--only NAME]...      (or: ./scripts/bench.sh scenes)
+//! ```
+//!
+//! Scenes ([`raylane_bench::meshes`]): the vendored bunny (3,674 triangles) and its Loop
+//! subdivisions (×1, ×2, ×3, ×4 = 940,544 triangles), spot, fandisk and the Stanford bunny
+//! from `../shared/meshes` when present, 10^5 spheres. Rays: 640×480 primary rays from an eye
+//! framing the scene; one cosine-weighted diffuse bounce (seeded) and one shadow ray to a point
+//! light (any-hit) from every primary hit.
+//!
+//! Contenders: Embree 3 (`rtcIntersect1/8/16`, `rtcOccluded1/8`, one-thread device), obvhs
+//! (CWBVH), parry3d (`TriMesh`), raylane brute force with bounding spheres (parts of about
+//! √n/2 triangles: `Watertight` x8, and the focal cache x8/x16 for primary rays with the cache
+//! built inside each timed frame), and raylane's BVH once merged. Before timing, every
+//! contender's answers are compared with the reference (raylane's scalar `Watertight` over the
+//! parts, i.e. exact brute force; for the spheres, scalar `Robust` brute force on every 61st
+//! ray): hit/miss disagreements and `t` differences beyond 10^-3 relative are counted, and a
+//! contender with more than 10^-4 of its rays differing is reported and not timed.
+//!
+//! Each frame is run `--runs` times (default 7; 3 above 10^5 triangles), the contenders of one
+//! kind of ray in turn (round robin, so that the machine's load drifts over all of them
+//! alike), and the median kept.
+//! The tables (markdown) go to stdout: scenes, build time and bytes per triangle, rays/s per
+//! kind of ray with the ratio to Embree, rays/s against the triangle count, and the goals.
+
+use std::cell::RefCell;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+use glam::Vec3;
+use raylane::bvh::{Bvh, Leaf};
+use raylane::{Ray, RayPacket};
+use raylane_bench::bvh_peers::{
+    EmbreeBvh, EmbreeRays, ObvhsBvh, ParryMesh, obvhs_rays, parry_rays,
+};
+use raylane_bench::bvh_raylane as rl;
+use raylane_bench::cpu;
+use raylane_bench::meshes::{self, Answers, MeshData, SurfaceHit, Workload};
+use raylane_bench::parts::{self, Parts};
+use wide::{f32x8, f32x16};
+
+/// The three kinds of rays.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+enum Kind {
+    Primary,
+    Diffuse,
+    Shadow,
+}
+
+impl Kind {
+    fn name(self) -> &'static str {
+        match self {
+            Kind::Primary => "primary",
+            Kind::Diffuse => "diffuse (incoherent)",
+            Kind::Shadow => "shadow (any hit)",
+        }
+    }
+}
+
+/// One contender on one kind of ray: its frame and its answers.
+struct Job<'a> {
+    name: String,
+    /// Rays its frame traces.
+    rays: usize,
+    /// True when it traces every ray (its answers are then thinned to the reference's
+    /// sample); false when it traces the sample only.
+    full: bool,
+    run: Box<dyn Fn() -> u32 + 'a>,
+    answers: Box<dyn Fn() -> Answers + 'a>,
+}
+
+fn job<'a>(
+    name: impl Into<String>,
+    (rays, full): (usize, bool),
+    run: impl Fn() -> u32 + 'a,
+    answers: impl Fn() -> Answers + 'a,
+) -> Job<'a> {
+    Job {
+        name: name.into(),
+        rays,
+        full,
+        run: Box::new(run),
+        answers: Box::new(answers),
+    }
+}
+
+fn collect(f: impl FnOnce(Option<&mut Answers>) -> u32) -> Answers {
+    let mut out = Vec::new();
+    f(Some(&mut out));
+    out
+}
+
+/// What was measured.
+#[derive(Default)]
+struct Results {
+    /// (scene, triangles or spheres, hit fraction, diffuse rays, shadow rays, note).
+    scenes: Vec<(String, usize, f64, usize, usize, String)>,
+    /// (scene, contender) → (build seconds, bytes per primitive).
+    builds: BTreeMap<(String, String), (f64, f64)>,
+    /// (kind, scene, contender) → rays/s.
+    speed: BTreeMap<(Kind, String, String), f64>,
+    /// Scene order and sizes.
+    order: Vec<(String, usize)>,
+    /// Check failures.
+    failed: Vec<String>,
+}
+
+struct Opts {
+    runs: Option<usize>,
+    only: Vec<String>,
+}
+
+/// The median of some timings.
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    v.get(v.len() / 2).copied().unwrap_or(f64::NAN)
+}
+
+/// Compares answers with the reference: (rays differing, largest |Δt|/t where both hit).
+fn check(got: &Answers, want: &Answers) -> (usize, f64) {
+    let mut bad = got.len().abs_diff(want.len());
+    let mut worst = 0f64;
+    for (g, w) in got.iter().zip(want) {
+        match (g, w) {
+            (Some((a, _)), Some((b, _))) => {
+                let d = (*a as f64 - *b as f64).abs() / (*b as f64).abs().max(1e-30);
+                if d > 1e-3 {
+                    bad += 1;
+                } else {
+                    worst = worst.max(d);
+                }
+            }
+            (None, None) => {}
+            _ => bad += 1,
+        }
+    }
+    (bad, worst)
+}
+
+/// Checks and times the jobs of one kind of ray; `want` answers every `stride`-th ray.
+fn run_jobs(
+    res: &mut Results,
+    scene: &str,
+    kind: Kind,
+    (want, stride): (&Answers, usize),
+    jobs: Vec<Job>,
+    runs: usize,
+) {
+    println!("  {} rays (reference: {} rays)", kind.name(), want.len());
+    let mut timed = Vec::new();
+    for j in jobs {
+        let got = (j.answers)();
+        let got: Answers = if j.full {
+            got.into_iter().step_by(stride).collect()
+        } else {
+            got
+        };
+        let (bad, worst) = check(&got, want);
+        // At most one ray in 10^4 (and at least one) may differ: grazing rays between two
+        // triangles, where kernels of different rounding legitimately disagree.
+        if bad <= (want.len() / 10_000).max(1) {
+            timed.push((
+                j,
+                format!("{bad} differ, max |Δt|/t {worst:.1e}"),
+                Vec::new(),
+            ));
+        } else {
+            println!(
+                "    {:<44} {bad} rays differ, max |Δt|/t {worst:.1e}  FAILED: not timed",
+                j.name
+            );
+            res.failed.push(format!(
+                "{scene} / {} / {}: {bad} of {} rays differ",
+                kind.name(),
+                j.name,
+                want.len()
+            ));
+        }
+    }
+    // Round robin: every contender once per round, so that the machine's load drifts over
+    // all of them alike; the median of the rounds.
+    for _ in 0..runs {
+        for (j, _, secs) in &mut timed {
+            let s = Instant::now();
+            std::hint::black_box((j.run)());
+            secs.push(s.elapsed().as_secs_f64());
+        }
+    }
+    for (j, checked, mut secs) in timed {
+        secs.sort_by(f64::total_cmp);
+        let rps = j.rays as f64 / secs[secs.len() / 2];
+        println!(
+            "    {:<44} {checked}  {:>9} rays/s ({} rays)",
+            j.name,
+            si(rps),
+            j.rays
+        );
+        res.speed
+            .insert((kind, scene.to_string(), j.name.clone()), rps);
+    }
+}
+
+fn si(x: f64) -> String {
+    if x >= 1e9 {
+        format!("{:.2} G", x / 1e9)
+    } else if x >= 1e6 {
+        format!("{:.2} M", x / 1e6)
+    } else if x >= 1e3 {
+        format!("{:.1} k", x / 1e3)
+    } else {
+        format!("{x:.0}")
+    }
+}
+
+/// Geometric normal of triangle `i`.
+fn normal(m: &MeshData, i: u32) -> Vec3 {
+    let [a, b, c] = m.indices[i as usize];
+    let p = |k: u32| m.positions[k as usize];
+    (p(b) - p(a)).cross(p(c) - p(a))
+}
+
+/// raylane's BVH's name in the build table.
+const BVH: &str = "raylane BVH";
+
+/// Scenes above this many primitives are checked, and traced by raylane's brute force, on
+/// every [`STRIDE`]-th ray only (every ray otherwise).
+const SAMPLED_ABOVE: usize = 50_000;
+/// The stride of the sample.
+const STRIDE: usize = 61;
+
+/// The peers' jobs on every ray of one kind (`shadow`: any-hit queries).
+fn peer_jobs<'a>(
+    shadow: bool,
+    rays: &[Ray],
+    e: &'a EmbreeBvh,
+    ob: &'a ObvhsBvh,
+    pa: Option<&'a ParryMesh>,
+    keep: &'a Keep,
+) -> Vec<Job<'a>> {
+    let er: &'a EmbreeRays = keep.put(EmbreeRays::new(rays));
+    let orays: &'a Vec<obvhs::ray::Ray> = keep.put(obvhs_rays(rays));
+    let all = (rays.len(), true);
+    let mut jobs = Vec::new();
+    if shadow {
+        jobs.push(job(
+            "Embree rtcOccluded1",
+            all,
+            move || e.occluded1(er, None),
+            move || collect(|o| e.occluded1(er, o)),
+        ));
+        jobs.push(job(
+            "Embree rtcOccluded8",
+            all,
+            move || e.occluded8(er, None),
+            move || collect(|o| e.occluded8(er, o)),
+        ));
+        jobs.push(job(
+            "obvhs ray_traverse_miss",
+            all,
+            move || ob.occluded(orays, None),
+            move || collect(|o| ob.occluded(orays, o)),
+        ));
+    } else {
+        jobs.push(job(
+            "Embree rtcIntersect1",
+            all,
+            move || e.intersect1(er, None),
+            move || collect(|o| e.intersect1(er, o)),
+        ));
+        jobs.push(job(
+            "Embree rtcIntersect8",
+            all,
+            move || e.intersect8(er, None),
+            move || collect(|o| e.intersect8(er, o)),
+        ));
+        jobs.push(job(
+            "Embree rtcIntersect16",
+            all,
+            move || e.intersect16(er, None),
+            move || collect(|o| e.intersect16(er, o)),
+        ));
+        jobs.push(job(
+            "obvhs ray_traverse",
+            all,
+            move || ob.closest(orays, None),
+            move || collect(|o| ob.closest(orays, o)),
+        ));
+    }
+    if let Some(pa) = pa {
+        let prays: &'a Vec<(parry3d::query::Ray, f32)> = keep.put(parry_rays(rays));
+        if shadow {
+            jobs.push(job(
+                "parry3d intersects_local_ray",
+                all,
+                move || pa.occluded(prays, None),
+                move || collect(|o| pa.occluded(prays, o)),
+            ));
+        } else {
+            jobs.push(job(
+                "parry3d cast_local_ray",
+                all,
+                move || pa.closest(prays, None),
+                move || collect(|o| pa.closest(prays, o)),
+            ));
+        }
+    }
+    jobs
+}
+
+/// raylane's BVH on every ray of one kind: single rays and packets of 8 and 16.
+fn bvh_jobs<'a, P: Leaf>(
+    shadow: bool,
+    all: &'a [Ray],
+    t: &'a Bvh<'a, P>,
+    keep: &'a Keep,
+) -> Vec<Job<'a>> {
+    let b8: &Vec<RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(all));
+    let b16: &Vec<RayPacket<f32x16>> = keep.put(rl::packets::<f32x16>(all));
+    let (n, every) = (all.len(), (all.len(), true));
+    if shadow {
+        vec![
+            job(
+                "raylane BVH any x1",
+                every,
+                move || rl::bvh_any1(t, all, None),
+                move || collect(|o| rl::bvh_any1(t, all, o)),
+            ),
+            job(
+                "raylane BVH any x8",
+                every,
+                move || rl::bvh_any(t, b8, n, None),
+                move || collect(|o| rl::bvh_any(t, b8, n, o)),
+            ),
+            job(
+                "raylane BVH any x16",
+                every,
+                move || rl::bvh_any(t, b16, n, None),
+                move || collect(|o| rl::bvh_any(t, b16, n, o)),
+            ),
+        ]
+    } else {
+        vec![
+            job(
+                "raylane BVH x1",
+                every,
+                move || rl::bvh_closest1(t, all, None),
+                move || collect(|o| rl::bvh_closest1(t, all, o)),
+            ),
+            job(
+                "raylane BVH x8",
+                every,
+                move || rl::bvh_closest(t, b8, n, None),
+                move || collect(|o| rl::bvh_closest(t, b8, n, o)),
+            ),
+            job(
+                "raylane BVH x16",
+                every,
+                move || rl::bvh_closest(t, b16, n, None),
+                move || collect(|o| rl::bvh_closest(t, b16, n, o)),
+            ),
+        ]
+    }
+}
+
+/// Keeps the converted rays of a scene alive while its jobs borrow them.
+#[derive(Default)]
+struct Keep(RefCell<Vec<Box<dyn std::any::Any>>>);
+
+impl Keep {
+    fn put<T: 'static>(&self, v: T) -> &T {
+        let b = Box::new(v);
+        let p: *const T = &*b;
+        self.0.borrow_mut().push(b);
+        // SAFETY: the box is never dropped or moved out before `self` is dropped, and its heap
+        // allocation does not move when the vector grows.
+        unsafe { &*p }
+    }
+}
+
+/// Every `stride`-th ray.
+fn thin(rays: &[Ray], stride: usize) -> Vec<Ray> {
+    rays.iter().step_by(stride).copied().collect()
+}
+
+fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
+    let n = m.len();
+    let runs = opts.runs.unwrap_or(if n > 100_000 { 3 } else { 7 });
+    let stride = if n > SAMPLED_ABOVE { STRIDE } else { 1 };
+    let name = m.name.clone();
+    println!(
+        "\n### {name}: {n} triangles, {} vertices",
+        m.positions.len()
+    );
+    let (centre, radius) = m.bounds();
+    let cam = meshes::framing(centre, radius);
+    let tris = m.triangles();
+
+    // Every structure is built `runs` times, round robin, and the median build time kept
+    // (the last build of each is used).
+    let size = rl::part_size(n);
+    let label_bf = "raylane brute force + spheres".to_string();
+    let mut times: [Vec<f64>; 5] = Default::default();
+    let mut built = None;
+    for _ in 0..runs {
+        let start = Instant::now();
+        let parts = Parts::new(&tris, size);
+        times[0].push(start.elapsed().as_secs_f64());
+        let ebr = EmbreeBvh::mesh(m, true);
+        times[1].push(ebr.build.as_secs_f64());
+        let obv = ObvhsBvh::mesh(m);
+        times[2].push(obv.build.as_secs_f64());
+        let par = ParryMesh::new(m);
+        times[3].push(par.build.as_secs_f64());
+        let tree = rl::Tree::mesh(&m.positions, &m.indices);
+        times[4].push(tree.build.as_secs_f64());
+        built = Some((parts, ebr, obv, par, tree));
+    }
+    let (parts, mut ebr, obv, par, tree) = built.expect("at least one run");
+    let [t_bf, t_e, t_o, t_p, t_t] = times.map(median);
+    let bounded = parts.meshes();
+    let ids = parts.ids();
+    let bf_bytes = (36 + 12 + 88) as f64 + 20.0 * parts.len() as f64 / n as f64;
+    let e_bytes = ebr.bytes.saturating_sub(ebr.buffer_bytes) as f64 / n as f64;
+    for (c, v) in [
+        (label_bf.clone(), (t_bf, bf_bytes)),
+        ("Embree".into(), (t_e, e_bytes)),
+        ("obvhs".into(), (t_o, obv.bytes() as f64 / n as f64)),
+        ("parry3d".into(), (t_p, f64::NAN)),
+        (BVH.to_string(), (t_t, tree.bytes() as f64 / n as f64)),
+    ] {
+        res.builds.insert((name.clone(), c), v);
+    }
+    let tb = tree.bvh();
+
+    // The secondary rays start from Embree's primary hits (checked below like every other
+    // answer).
+    let primary = Workload::primary(&cam);
+    let e_hits = collect(|o| ebr.intersect1(&EmbreeRays::new(&primary), o));
+    let hits: Vec<SurfaceHit> = e_hits
+        .iter()
+        .map(|h| h.map(|(t, i)| (t, normal(m, i))))
+        .collect();
+    let w = Workload::new(cam, &hits, centre, radius);
+    let frac = e_hits.iter().filter(|h| h.is_some()).count() as f64 / primary.len() as f64;
+    res.scenes.push((
+        name.clone(),
+        n,
+        frac,
+        w.diffuse.len(),
+        w.shadow.len(),
+        if stride > 1 {
+            format!("parts of {size}; reference and brute force on every {stride}st ray")
+        } else {
+            format!("parts of {size}")
+        },
+    ));
+    res.order.push((name.clone(), n));
+
+    let keep = Keep::default();
+    let store = RefCell::new(parts.storage());
+    for kind in [Kind::Primary, Kind::Diffuse, Kind::Shadow] {
+        let all: &[Ray] = match kind {
+            Kind::Primary => &w.primary,
+            Kind::Diffuse => &w.diffuse,
+            Kind::Shadow => &w.shadow,
+        };
+        let shadow = kind == Kind::Shadow;
+        // The reference: scalar Watertight over the parts (exact brute force).
+        let sample = thin(all, stride);
+        let p1 = rl::packets::<f32>(&sample);
+        let want = if shadow {
+            collect(|o| rl::any(&p1, &bounded, sample.len(), o))
+        } else {
+            collect(|o| rl::closest(&p1, &bounded, ids, sample.len(), o))
+        };
+        ebr.set_coherent(kind == Kind::Primary);
+        let mut jobs = peer_jobs(shadow, all, &ebr, &obv, Some(&par), &keep);
+        let s8: &Vec<RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(&sample));
+        let (b, ns) = (&bounded, sample.len());
+        let few = (ns, false);
+        if shadow {
+            jobs.push(job(
+                format!("{label_bf} any x8"),
+                few,
+                move || rl::any(s8, b, ns, None),
+                move || collect(|o| rl::any(s8, b, ns, o)),
+            ));
+        } else {
+            jobs.push(job(
+                format!("{label_bf} x8"),
+                few,
+                move || rl::closest(s8, b, ids, ns, None),
+                move || collect(|o| rl::closest(s8, b, ids, ns, o)),
+            ));
+        }
+        jobs.extend(bvh_jobs(shadow, all, &tb, &keep));
+        if kind == Kind::Primary {
+            // The focal parts over every primary ray, the cache built for the eye inside
+            // every frame.
+            let (eye, pp, st, nr) = (w.cam.eye, &parts, &store, all.len());
+            let p8: &Vec<RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(all));
+            let p16: &Vec<RayPacket<f32x16>> = keep.put(rl::packets::<f32x16>(all));
+            let every = (nr, true);
+            jobs.push(job(
+                "raylane focal + spheres x8",
+                every,
+                move || {
+                    let mut s = st.borrow_mut();
+                    parts::frame(p8, &pp.focus(eye, &mut s))
+                },
+                move || {
+                    let mut s = st.borrow_mut();
+                    rl::focal_answers(p8, &pp.focus(eye, &mut s), nr)
+                },
+            ));
+            jobs.push(job(
+                "raylane focal + spheres x16",
+                every,
+                move || {
+                    let mut s = st.borrow_mut();
+                    parts::frame(p16, &pp.focus(eye, &mut s))
+                },
+                move || {
+                    let mut s = st.borrow_mut();
+                    rl::focal_answers(p16, &pp.focus(eye, &mut s), nr)
+                },
+            ));
+        }
+        run_jobs(res, &name, kind, (&want, stride), jobs, runs);
+    }
+}
+
+/// The sphere field: the reference is scalar `Robust` brute force on every [`STRIDE`]-th
+/// ray; the secondary rays start from Embree's primary hits.
+fn sphere_scene(res: &mut Results, count: usize, opts: &Opts) {
+    let runs = opts.runs.unwrap_or(3);
+    let spheres = meshes::sphere_field(count);
+    let name = format!("{count} spheres");
+    println!("\n### {name}");
+    let r = spheres.iter().map(|s| s.radius()).fold(0.0, f32::max);
+    let (centre, radius) = (Vec3::ZERO, 3f32.sqrt() * (1.0 + r));
+    let cam = meshes::framing(centre, radius);
+    let primary = Workload::primary(&cam);
+    let mut times: [Vec<f64>; 3] = Default::default();
+    let mut built = None;
+    for _ in 0..runs {
+        let ebr = EmbreeBvh::spheres(&spheres, true);
+        times[0].push(ebr.build.as_secs_f64());
+        let obv = ObvhsBvh::spheres(&spheres);
+        times[1].push(obv.build.as_secs_f64());
+        let tree = rl::Tree::spheres(&spheres);
+        times[2].push(tree.build.as_secs_f64());
+        built = Some((ebr, obv, tree));
+    }
+    let (mut ebr, obv, tree) = built.expect("at least one run");
+    let [t_e, t_o, t_t] = times.map(median);
+    let e_bytes = ebr.bytes.saturating_sub(ebr.buffer_bytes) as f64 / count as f64;
+    for (c, v) in [
+        ("Embree".to_string(), (t_e, e_bytes)),
+        ("obvhs".into(), (t_o, obv.bytes() as f64 / count as f64)),
+        (BVH.to_string(), (t_t, tree.bytes() as f64 / count as f64)),
+    ] {
+        res.builds.insert((name.clone(), c), v);
+    }
+    let tb = tree.bvh();
+    let e_hits = collect(|o| ebr.intersect1(&EmbreeRays::new(&primary), o));
+    let hits: Vec<SurfaceHit> = primary
+        .iter()
+        .zip(&e_hits)
+        .map(|(ray, h)| h.map(|(t, i)| (t, ray.at(t) - spheres[i as usize].center())))
+        .collect();
+    let w = Workload::new(cam, &hits, centre, radius);
+    let frac = e_hits.iter().filter(|h| h.is_some()).count() as f64 / primary.len() as f64;
+    res.scenes.push((
+        name.clone(),
+        count,
+        frac,
+        w.diffuse.len(),
+        w.shadow.len(),
+        format!("reference and brute force on every {STRIDE}st ray"),
+    ));
+    res.order.push((name.clone(), count));
+    let keep = Keep::default();
+    for kind in [Kind::Primary, Kind::Diffuse, Kind::Shadow] {
+        let all: &[Ray] = match kind {
+            Kind::Primary => &w.primary,
+            Kind::Diffuse => &w.diffuse,
+            Kind::Shadow => &w.shadow,
+        };
+        let shadow = kind == Kind::Shadow;
+        let sample = thin(all, STRIDE);
+        let p1 = rl::packets::<f32>(&sample);
+        let occluded = |mut a: Answers| {
+            if shadow {
+                a.iter_mut().for_each(|h| *h = h.map(|_| (0.0, 0)));
+            }
+            a
+        };
+        let want = occluded(collect(|o| {
+            rl::spheres_closest(&p1, &spheres, sample.len(), o)
+        }));
+        ebr.set_coherent(kind == Kind::Primary);
+        let mut jobs = peer_jobs(shadow, all, &ebr, &obv, None, &keep);
+        let p16: &Vec<RayPacket<f32x16>> = keep.put(rl::packets::<f32x16>(&sample));
+        let (sp, ns) = (&spheres, sample.len());
+        jobs.push(job(
+            "raylane brute force robust x16",
+            (ns, false),
+            move || rl::spheres_closest(p16, sp, ns, None),
+            move || occluded(collect(|o| rl::spheres_closest(p16, sp, ns, o))),
+        ));
+        jobs.extend(bvh_jobs(shadow, all, &tb, &keep));
+        run_jobs(res, &name, kind, (&want, STRIDE), jobs, runs);
+    }
+}
+
+fn main() {
+    let mut opts = Opts {
+        runs: None,
+        only: Vec::new(),
+    };
+    let mut args = std::env::args().skip(1);
+    while let Some(a) = args.next() {
+        match a.as_str() {
+            "--runs" => opts.runs = args.next().and_then(|v| v.parse().ok()),
+            "--only" => opts.only.extend(args.next()),
+            // cargo bench passes --bench
+            "--bench" => {}
+            _ => {
+                eprintln!("usage: scenes [--runs N] [--only NAME]...");
+                std::process::exit(2);
+            }
+        }
+    }
+    let wanted =
+        |name: &str| opts.only.is_empty() || opts.only.iter().any(|o| name.contains(o.as_str()));
+    let started = Instant::now();
+    println!("CPU: {}", cpu());
+    let mut res = Results::default();
+    let mut list: Vec<MeshData> = vec![meshes::vendored_bunny()];
+    list.extend(meshes::shared_meshes());
+    if list.len() == 1 {
+        println!("(../shared/meshes absent: spot, fandisk and the Stanford bunny skipped)");
+    }
+    for steps in 1..=4 {
+        let name = format!("bunny Loop×{steps}");
+        if wanted(&name) {
+            let s = Instant::now();
+            let m = meshes::subdivided_bunny(steps);
+            println!("{name}: subdivided in {:.2} s", s.elapsed().as_secs_f64());
+            list.push(m);
+        }
+    }
+    list.sort_by_key(|m| m.len());
+    // Warm-up: the process's first Embree device starts its task system and picks its ISA,
+    // which would otherwise be counted in the first scene's build time.
+    drop(EmbreeBvh::mesh(&list[0], true));
+    for m in &list {
+        if wanted(&m.name) {
+            mesh_scene(&mut res, m, &opts);
+        }
+    }
+    if wanted("spheres") {
+        sphere_scene(&mut res, 100_000, &opts);
+    }
+    report(&res);
+    println!("\n(total {:.0} s)", started.elapsed().as_secs_f64());
+}
+
+/// The contender whose rays/s the goals compare with the peers: raylane's fastest.
+fn best_raylane(res: &Results, kind: Kind, scene: &str) -> Option<(String, f64)> {
+    res.speed
+        .iter()
+        .filter(|((k, s, c), _)| *k == kind && s == scene && c.starts_with("raylane"))
+        .map(|((_, _, c), v)| (c.clone(), *v))
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+fn get(res: &Results, kind: Kind, scene: &str, c: &str) -> Option<f64> {
+    res.speed
+        .get(&(kind, scene.to_string(), c.to_string()))
+        .copied()
+}
+
+fn report(res: &Results) {
+    println!("\n## Scenes of 10^3 to 10^6 primitives (issue 14)\n");
+    println!(
+        "CPU: {}; one thread for every contender (Embree's device too).\n",
+        cpu()
+    );
+    println!("| scene | primitives | primary rays hit | diffuse rays | shadow rays | note |");
+    println!("| --- | ---: | ---: | ---: | ---: | --- |");
+    for (s, n, f, d, sh, note) in &res.scenes {
+        println!("| {s} | {n} | {:.1} % | {d} | {sh} | {note} |", 100.0 * f);
+    }
+
+    println!("\n### Build time and size\n");
+    println!(
+        "Bytes per primitive: the acceleration structure and any copy of the primitives it needs, without the caller's vertex and index arrays (Embree: its memory monitor minus its buffers; raylane's parts: vertex copies, indices and the focal cache).\n"
+    );
+    let contenders: Vec<String> = {
+        let mut c: Vec<String> = res.builds.keys().map(|(_, c)| c.clone()).collect();
+        c.sort();
+        c.dedup();
+        c
+    };
+    let mut head = String::from("| scene |");
+    let mut rule = String::from("| --- |");
+    for c in &contenders {
+        head += &format!(" {c} |");
+        rule += " ---: |";
+    }
+    println!("{head}\n{rule}");
+    for (s, _) in &res.order {
+        let mut row = format!("| {s} |");
+        for c in &contenders {
+            match res.builds.get(&(s.clone(), c.clone())) {
+                Some((t, b)) if b.is_finite() => row += &format!(" {:.1} ms, {b:.0} B |", 1e3 * t),
+                Some((t, _)) => row += &format!(" {:.1} ms |", 1e3 * t),
+                None => row += " — |",
+            }
+        }
+        println!("{row}");
+    }
+
+    for kind in [Kind::Primary, Kind::Diffuse, Kind::Shadow] {
+        let reference = match kind {
+            Kind::Primary => "Embree rtcIntersect8",
+            Kind::Diffuse => "Embree rtcIntersect1",
+            Kind::Shadow => "Embree rtcOccluded8",
+        };
+        println!("\n### {} rays: rays/s (× {reference})\n", kind.name());
+        let mut names: Vec<String> = res
+            .speed
+            .keys()
+            .filter(|(k, _, _)| *k == kind)
+            .map(|(_, _, c)| c.clone())
+            .collect();
+        names.sort();
+        names.dedup();
+        let scenes: Vec<&(String, usize)> = res.order.iter().collect();
+        let mut head = String::from("| contender |");
+        let mut rule = String::from("| --- |");
+        for (s, n) in &scenes {
+            head += &format!(" {s} ({}) |", short(*n));
+            rule += " ---: |";
+        }
+        println!("{head}\n{rule}");
+        for c in names {
+            let mut row = format!("| {c} |");
+            for (s, _) in &scenes {
+                match (get(res, kind, s, &c), get(res, kind, s, reference)) {
+                    (Some(v), Some(r)) => row += &format!(" {} ({:.2}) |", si(v), v / r),
+                    (Some(v), None) => row += &format!(" {} |", si(v)),
+                    _ => row += " — |",
+                }
+            }
+            println!("{row}");
+        }
+    }
+
+    println!("\n### Primary rays/s against the number of primitives (fastest variant of each)\n");
+    let families = [
+        ("Embree", "Embree rtc"),
+        ("obvhs", "obvhs"),
+        ("parry3d", "parry3d"),
+        ("raylane brute force + spheres", "raylane brute force"),
+        ("raylane focal + spheres", "raylane focal"),
+        ("raylane BVH", "raylane BVH"),
+    ];
+    let mut head = String::from("| scene | primitives |");
+    let mut rule = String::from("| --- | ---: |");
+    for (f, _) in families {
+        head += &format!(" {f} |");
+        rule += " ---: |";
+    }
+    println!("{head}\n{rule}");
+    for (s, n) in &res.order {
+        let mut row = format!("| {s} | {n} |");
+        for (_, prefix) in families {
+            let best = res
+                .speed
+                .iter()
+                .filter(|((k, ss, c), _)| *k == Kind::Primary && ss == s && c.starts_with(prefix))
+                .map(|(_, v)| *v)
+                .fold(f64::NAN, f64::max);
+            row += &if best.is_nan() {
+                " — |".to_string()
+            } else {
+                format!(" {} |", si(best))
+            };
+        }
+        println!("{row}");
+    }
+
+    println!("\n## Goals (issue 14): raylane's fastest contender on each scene\n");
+    println!("| goal | scene | raylane | peer | factor | met |");
+    println!("| --- | --- | --- | ---: | ---: | --- |");
+    let goals = [
+        (
+            "primary ≥ 1.5× rtcIntersect8",
+            Kind::Primary,
+            "Embree rtcIntersect8",
+            1.5,
+        ),
+        (
+            "incoherent ≥ 1.0× rtcIntersect1",
+            Kind::Diffuse,
+            "Embree rtcIntersect1",
+            1.0,
+        ),
+        (
+            "shadow ≥ 1.0× rtcOccluded8",
+            Kind::Shadow,
+            "Embree rtcOccluded8",
+            1.0,
+        ),
+        (
+            "primary ≥ 10× parry3d",
+            Kind::Primary,
+            "parry3d cast_local_ray",
+            10.0,
+        ),
+    ];
+    for (goal, kind, peer, want) in goals {
+        for (s, _) in &res.order {
+            if let (Some((c, v)), Some(p)) = (best_raylane(res, kind, s), get(res, kind, s, peer)) {
+                let f = v / p;
+                println!(
+                    "| {goal} | {s} | {c}: {} | {} | {f:.2}× | {} |",
+                    si(v),
+                    si(p),
+                    if f >= want {
+                        "met".to_string()
+                    } else {
+                        format!("missed ({:.2}× short)", want / f)
+                    }
+                );
+            }
+        }
+    }
+    for (s, _) in &res.order {
+        let e = res.builds.get(&(s.clone(), "Embree".to_string()));
+        let ours = res.builds.get(&(s.clone(), BVH.to_string()));
+        if let (Some(e), Some(&(t, _))) = (e, ours) {
+            let c = BVH;
+            let f = t / e.0;
+            println!(
+                "| build ≤ 2× Embree | {s} | {c}: {:.1} ms | {:.1} ms | {f:.2}× | {} |",
+                1e3 * t,
+                1e3 * e.0,
+                if f <= 2.0 {
+                    "met".to_string()
+                } else {
+                    format!("missed ({:.2}× over)", f / 2.0)
+                }
+            );
+        }
+    }
+    if !res.failed.is_empty() {
+        println!("\nNot timed (answers differ from the reference):\n");
+        for f in &res.failed {
+            println!("* {f}");
+        }
+    }
+}
+
+fn short(n: usize) -> String {
+    if n >= 1_000_000 {
+        format!("{:.2} M", n as f64 / 1e6)
+    } else if n >= 1000 {
+        format!("{:.1} k", n as f64 / 1e3)
+    } else {
+        n.to_string()
+    }
+}

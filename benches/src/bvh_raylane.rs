@@ -1,0 +1,281 @@
+//! raylane's contenders in the BVH benchmark (`examples/scenes.rs`), over the same rays as
+//! the peers of [`crate::bvh_peers`]:
+//!
+//! * brute force with bounding spheres: the mesh in parts of a few hundred triangles with a
+//!   bounding sphere each ([`crate::parts`]), every part's sphere tested per packet, the
+//!   triangles only of parts a lane may hit: `Watertight` for every kind of ray (closest and
+//!   any), and the focal cache for the primary rays (built per eye, inside the timing);
+//! * the reference tracer every contender is checked against: the same parts with the scalar
+//!   `Watertight` kernel (exact brute force, with each hit's triangle index);
+//! * raylane's BVH ([`Tree`], [`raylane::bvh`]): built from the indexed mesh or the spheres,
+//!   single rays (`closest`, `any`) and packets of 8 and 16 (`closest_packet`, `any_packet`).
+//!
+//! Every function returns the number of rays hit and, when `out` is given, pushes one answer
+//! per ray (`(t, triangle)`; `(0, 0)` for an occluded shadow ray).
+
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use glam::Vec3;
+use raylane::bvh::{self, Bvh, Leaf, Node, Primitives, Scratch, Sphere4, Tri4};
+use raylane::mesh::{FocalMesh, Mesh};
+use raylane::sphere::{self, Robust, Sphere};
+use raylane::triangle::{Cull, Watertight};
+use raylane::{Lane, Mask, Query, Ray, RayPacket};
+
+use crate::meshes::Answers;
+
+/// Triangles per part for a mesh of `n` triangles: about √n / 2, a power of two in
+/// [16, 512], which balances the sphere tests (n / size per packet) against the triangles of
+/// the parts hit.
+pub fn part_size(n: usize) -> usize {
+    ((n as f64).sqrt() / 2.0)
+        .clamp(16.0, 512.0)
+        .log2()
+        .round()
+        .exp2() as usize
+}
+
+/// Ray packets of `L::LANES` rays (the last one padded with rays that never hit).
+pub fn packets<L: Lane<Scalar = f32>>(rays: &[Ray]) -> Vec<RayPacket<L>> {
+    rays.chunks(L::LANES).map(RayPacket::from_rays).collect()
+}
+
+/// Closest hits over the parts with `Watertight`; `ids[p][i]` is the input index of triangle
+/// `i` of part `p`.
+#[inline(never)]
+pub fn closest<L: Lane<Scalar = f32>>(
+    packets: &[RayPacket<L>],
+    meshes: &[Mesh],
+    ids: &[Vec<u32>],
+    rays: usize,
+    mut out: Option<&mut Answers>,
+) -> u32 {
+    let mut n = 0;
+    for p in packets {
+        let mut r = *black_box(p);
+        let mut best = [None; 16];
+        let mut mask = L::Mask::splat(false);
+        for (k, m) in meshes.iter().enumerate() {
+            let h = m.closest::<Watertight, L>(&r, Cull::None);
+            if h.mask.any() {
+                r = r.shrink(h.mask, h.t);
+                mask = mask | h.mask;
+                if out.is_some() {
+                    for (i, b) in best.iter_mut().enumerate().take(L::LANES) {
+                        if let Some(rec) = h.lane(i) {
+                            *b = Some((rec.t, ids[k][rec.index as usize]));
+                        }
+                    }
+                }
+            }
+        }
+        n += mask.bits().count_ones();
+        if let Some(o) = out.as_deref_mut() {
+            o.extend_from_slice(&best[..L::LANES]);
+        }
+    }
+    if let Some(o) = out {
+        o.truncate(rays);
+    }
+    n
+}
+
+/// Any hit over the parts with `Watertight` (lanes found occluded drop out of later parts).
+#[inline(never)]
+pub fn any<L: Lane<Scalar = f32>>(
+    packets: &[RayPacket<L>],
+    meshes: &[Mesh],
+    rays: usize,
+    mut out: Option<&mut Answers>,
+) -> u32 {
+    let mut n = 0;
+    let gone = L::from_f32(f32::NEG_INFINITY);
+    for p in packets {
+        let mut r = *black_box(p);
+        let live = r.valid();
+        let mut occ = L::Mask::splat(false);
+        for m in meshes {
+            let h = m.any::<Watertight, L>(&r, Cull::None);
+            if h.any() {
+                occ = occ | h;
+                if (occ | !live).all() {
+                    break;
+                }
+                r = r.shrink(h, gone);
+            }
+        }
+        n += occ.bits().count_ones();
+        if let Some(o) = out.as_deref_mut() {
+            o.extend((0..L::LANES).map(|i| occ.test(i).then_some((0.0, 0))));
+        }
+    }
+    if let Some(o) = out {
+        o.truncate(rays);
+    }
+    n
+}
+
+/// Closest hits of primary rays over focal parts (the caches are built by the caller, per
+/// eye, inside the timing); `t` only (index 0).
+pub fn focal_answers<L: Lane<Scalar = f32>>(
+    packets: &[RayPacket<L>],
+    meshes: &[FocalMesh],
+    rays: usize,
+) -> Answers {
+    crate::parts::answers(packets, meshes, rays)
+        .into_iter()
+        .map(|t| t.map(|t| (t, 0)))
+        .collect()
+}
+
+/// Brute force over spheres (`Robust`, packets over the slice).
+#[inline(never)]
+pub fn spheres_closest<L: Lane<Scalar = f32>>(
+    packets: &[RayPacket<L>],
+    spheres: &[Sphere],
+    rays: usize,
+    mut out: Option<&mut Answers>,
+) -> u32 {
+    let mut n = 0;
+    for p in packets {
+        let h = sphere::closest::<Robust, L>(black_box(p), spheres);
+        n += h.mask.bits().count_ones();
+        if let Some(o) = out.as_deref_mut() {
+            o.extend((0..L::LANES).map(|i| h.lane(i).map(|r| (r.t, r.index))));
+        }
+    }
+    if let Some(o) = out {
+        o.truncate(rays);
+    }
+    n
+}
+
+/// raylane's BVH over owned storage (sized by [`bvh::needed`], trimmed to what the build used).
+pub struct Tree<P: Leaf> {
+    nodes: Vec<Node>,
+    leaves: Vec<P>,
+    /// Build time: storage allocation and [`bvh::build`].
+    pub build: Duration,
+}
+
+impl<P: Leaf> Tree<P> {
+    fn new<Q: Primitives<Leaf = P> + ?Sized>(prims: &Q) -> Self {
+        let start = Instant::now();
+        let need = bvh::needed(prims.count());
+        let mut nodes = vec![Node::EMPTY; need.nodes];
+        let mut leaves = vec![P::EMPTY; need.leaves];
+        let mut scratch = vec![Scratch::default(); need.scratch];
+        let (n, l) = {
+            let t = bvh::build(prims, &mut nodes, &mut leaves, &mut scratch)
+                .expect("storage from bvh::needed");
+            (t.nodes().len(), t.leaves().len())
+        };
+        let build = start.elapsed();
+        nodes.truncate(n);
+        leaves.truncate(l);
+        Tree {
+            nodes,
+            leaves,
+            build,
+        }
+    }
+
+    /// The tree.
+    pub fn bvh(&self) -> Bvh<'_, P> {
+        Bvh::from_parts(&self.nodes, &self.leaves).expect("a tree bvh::build made")
+    }
+
+    /// Bytes of the nodes and leaves.
+    pub fn bytes(&self) -> usize {
+        size_of_val(&self.nodes[..]) + size_of_val(&self.leaves[..])
+    }
+}
+
+impl Tree<Tri4> {
+    /// Over an indexed mesh (`Mesh::new(positions, indices)`).
+    pub fn mesh(positions: &[Vec3], indices: &[[u32; 3]]) -> Self {
+        Self::new(&Mesh::new(positions, indices))
+    }
+}
+
+impl Tree<Sphere4> {
+    /// Over spheres.
+    pub fn spheres(spheres: &[Sphere]) -> Self {
+        Self::new(spheres)
+    }
+}
+
+/// Closest hits of single rays through the BVH.
+#[inline(never)]
+pub fn bvh_closest1<P: Leaf>(t: &Bvh<P>, rays: &[Ray], mut out: Option<&mut Answers>) -> u32 {
+    let mut n = 0;
+    for r in rays {
+        let h = t.closest(black_box(r));
+        n += h.is_some() as u32;
+        if let Some(o) = out.as_deref_mut() {
+            o.push(h.map(|h| (h.t, h.index)));
+        }
+        black_box(&h);
+    }
+    n
+}
+
+/// Closest hits of ray packets through the BVH.
+#[inline(never)]
+pub fn bvh_closest<P: Leaf, L: Lane<Scalar = f32>>(
+    t: &Bvh<P>,
+    packets: &[RayPacket<L>],
+    rays: usize,
+    mut out: Option<&mut Answers>,
+) -> u32 {
+    let mut n = 0;
+    for p in packets {
+        let h = t.closest_packet(black_box(p));
+        n += h.mask.bits().count_ones();
+        if let Some(o) = out.as_deref_mut() {
+            o.extend((0..L::LANES).map(|i| h.lane(i).map(|r| (r.t, r.index))));
+        }
+        black_box(&h);
+    }
+    if let Some(o) = out {
+        o.truncate(rays);
+    }
+    n
+}
+
+/// Any hit of single rays through the BVH.
+#[inline(never)]
+pub fn bvh_any1<P: Leaf>(t: &Bvh<P>, rays: &[Ray], mut out: Option<&mut Answers>) -> u32 {
+    let mut n = 0;
+    for r in rays {
+        let h = t.any(black_box(r));
+        n += h as u32;
+        if let Some(o) = out.as_deref_mut() {
+            o.push(h.then_some((0.0, 0)));
+        }
+    }
+    n
+}
+
+/// Any hit of ray packets through the BVH.
+#[inline(never)]
+pub fn bvh_any<P: Leaf, L: Lane<Scalar = f32>>(
+    t: &Bvh<P>,
+    packets: &[RayPacket<L>],
+    rays: usize,
+    mut out: Option<&mut Answers>,
+) -> u32 {
+    let mut n = 0;
+    for p in packets {
+        let m = t.any_packet(black_box(p));
+        n += m.bits().count_ones();
+        if let Some(o) = out.as_deref_mut() {
+            o.extend((0..L::LANES).map(|i| m.test(i).then_some((0.0, 0))));
+        }
+    }
+    if let Some(o) = out {
+        o.truncate(rays);
+    }
+    n
+}

@@ -1,0 +1,431 @@
+//! A bounding volume hierarchy over caller storage: 8-wide nodes, leaves of 4 primitives packed
+//! for the "1 ray × N primitives" kernels, traversed by the same lanes, and **bit-identical to
+//! brute force**.
+//!
+//! # Build
+//!
+//! [`needed`] gives the storage for `n` primitives; [`build`] writes the tree into the caller's
+//! slices ([`Node`]s, leaves, [`Scratch`]) and returns a [`Bvh`] that borrows them: no
+//! allocation, no recursion, `no_std`. Short storage is an error value ([`BuildError`]).
+//!
+//! * **Binned SAH** (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies",
+//!   2007): primitive centroids in 16 bins per axis, a sweep over the 15 planes per axis for
+//!   the cheapest `A_L·N_L + A_R·N_R`, an in-place partition.
+//! * **Built wide directly**: a node starts with its whole range as one child and splits the
+//!   child of largest surface area (more than 4 primitives) until it has 8 children (as
+//!   Embree's wide builders do); a child of at most 4 primitives is one leaf.
+//! * **Deterministic.** Only IEEE-exact operations (comparisons, `+ − ×` in a fixed order, no
+//!   fused multiply-add) and fixed tie-breaking (lowest axis, lowest bin, lowest slot): the
+//!   same tree, bit for bit, on every target.
+//! * **Bounded depth.** From depth [`SAH_DEPTH`] on, ranges are split at their middle index
+//!   (largest range first), so the depth never exceeds [`MAX_DEPTH`] (for up to
+//!   [`MAX_PRIMITIVES`]), and the traversal's fixed-size stack ([`STACK`] entries, 2 KB) cannot
+//!   overflow; [`Bvh::from_parts`] refuses deeper trees.
+//! * **Bad input.** A primitive that no kernel can hit (NaN or infinite coordinates, zero area,
+//!   non-positive radius) gets an empty box and is never visited; coincident primitives are
+//!   split by index; nothing panics or loops.
+//! * [`refit`] recomputes every box after vertices move (same topology, same leaves).
+//!
+//! # Scenes
+//!
+//! [`Scene`] places objects (trees over a mesh or a sphere set) by affine transforms under a
+//! top-level tree of [`Inst4`] leaves; a query returns the closest hit over the scene with
+//! the instance id in [`Hit::set`](crate::Hit::set) (see [`scene`]).
+//!
+//! # Layout (plain data, `#[repr(C)]`)
+//!
+//! A tree is two slices: `nodes` ([`Node`], 224 bytes, root at index 0) and `leaves`
+//! ([`Tri4`], 160 bytes, or [`Sphere4`], 80 bytes). Children are numbered `child[k]`:
+//! [`EMPTY`] for an unused slot (its box is empty: `min = +inf`, `max = −inf`), `LEAF | i` for
+//! leaf `i`, otherwise the index of an inner node, always greater than the parent's. A tree
+//! built on a host can be placed in firmware flash as `static` arrays and reopened with
+//! [`Bvh::from_parts`].
+//!
+//! # Traversal and exactness
+//!
+//! A [`Bvh`] implements [`Query`](crate::Query): `closest`, `any`, `all` for one [`Ray`](crate::Ray)
+//! (children in lanes: one `f32x8` slab test per node, nearest child first; leaves with one
+//! `f32x4` kernel call: 1 ray × 4 primitives) or a [`RayPacket`](crate::RayPacket) of any width (1, 4, 8, 16
+//! rays: one child box per lane operation, inactive lanes masked; N rays × 1 primitive in the
+//! leaves). Triangles use [`Watertight`](crate::triangle::Watertight), spheres
+//! [`Robust`](crate::sphere::Robust), two-sided unless [`Bvh::with_cull`] says otherwise.
+//!
+//! ```
+//! use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
+//! use raylane::glam::Vec3;
+//! use raylane::triangle::Triangle;
+//! use raylane::{Query, Ray};
+//!
+//! let tris: Vec<Triangle> = (0..100)
+//!     .map(|i| {
+//!         let x = i as f32;
+//!         Triangle::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 0.0, 0.0), Vec3::new(x, 1.0, 0.0))
+//!     })
+//!     .collect();
+//! let need = bvh::needed(tris.len());
+//! let mut nodes = vec![Node::EMPTY; need.nodes];
+//! let mut leaves = vec![Tri4::EMPTY; need.leaves];
+//! let mut scratch = vec![Scratch::default(); need.scratch];
+//! let tree = bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch).unwrap();
+//! let ray = Ray::new(Vec3::new(42.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0));
+//! let hit = tree.closest(&ray).unwrap();
+//! assert_eq!((hit.index, hit.t), (42, 1.0));
+//! assert_eq!(Some(hit), tris[..].closest(&ray)); // the flat set's answer, bit for bit
+//! ```
+//!
+//! The closest hit is the one brute force finds with the same kernel: the smallest rounded `t`,
+//! ties to the lowest primitive index, with the same `t`, `u`, `v`, index bits (and so the same
+//! point, normal and face), whatever order the tree is visited in. Two things make it so:
+//!
+//! 1. **Lexicographic merge.** A candidate wins on `(t, index)`, and `t_max` is relaxed to
+//!    `t + |t|·2^-21` after each hit exactly as the brute-force loops do ([`crate::hit`]), so a
+//!    kernel's pre-division test never drops a would-be winner.
+//! 2. **Conservative boxes** (in the spirit of Ize, "Robust BVH Ray Traversal", JCGT 2013).
+//!    Each box is widened by `m = 2^-14·(R + |o|∞)`, with `R` the largest coordinate in the
+//!    tree and `o` the ray's origin: the Watertight kernel's edge tests and `t` are exact up to
+//!    a few `2^-24·|V − o|∞` (its sheared vertices and a convex combination of their depths),
+//!    and the slab test's own roundings are of the same order, so a reported hit always lies
+//!    well inside the widened box and its rounded `t` inside the slab interval. The widening
+//!    costs nothing per node: it is folded into two origins per ray (`o ± m` per axis, by the
+//!    sign of `d`). A zero direction component gives a `±2^100` inverse (never NaN), and rays
+//!    whose `|d|∞` lies outside `2^-64…2^64` or whose `R + |o|∞` exceeds `2^100` visit every
+//!    non-empty child (still exact, only slower).
+//!
+//! **One boundary case.** The brute-force loops test the first triangle with the ray's own
+//! `t_max`; this traversal starts from the relaxed `t_max` and keeps hits with `t < t_max`. The
+//! two differ only for a triangle whose rounded `t` lies within one rounding of a *finite*
+//! `t_max` and whose pre-division product rounds onto it, where brute force's answer depends
+//! on the triangles' order; rays with `t_max = +inf` are never affected.
+
+mod build;
+mod leaf;
+mod query;
+pub mod scene;
+mod traverse;
+
+pub use build::{build, refit};
+pub use leaf::{Leaf, Packed, Primitives, Sphere4, Tri4};
+pub use scene::{Inst4, Instance, Scene};
+
+use crate::triangle::Cull;
+
+/// Children per node (the lanes of one slab test).
+pub const WIDTH: usize = 8;
+/// Primitives per leaf (the lanes of one "1 ray × N primitives" kernel call).
+pub const LEAF_WIDTH: usize = 4;
+/// Bins per axis of the binned SAH.
+pub const BINS: usize = 16;
+/// Depth from which ranges are split at their middle index instead of by SAH.
+pub const SAH_DEPTH: u32 = 24;
+/// The deepest a built tree gets: the root is depth 1; from [`SAH_DEPTH`] on, a node splits
+/// its largest range 7 times at the middle index, so each level divides the largest range by
+/// 8, and [`MAX_PRIMITIVES`] reach leaves of at most 4 within 10 more levels.
+pub const MAX_DEPTH: u32 = SAH_DEPTH + 11;
+/// Entries of the traversal stack: at most `WIDTH − 1` siblings wait per level, plus one.
+pub const STACK: usize = (WIDTH - 1) * MAX_DEPTH as usize + 1;
+/// The most primitives a tree holds: `2^30 − 1`.
+pub const MAX_PRIMITIVES: usize = (1 << 30) - 1;
+/// `child[k]` of an unused slot.
+pub const EMPTY: u32 = u32::MAX;
+/// The bit that marks `child[k]` as a leaf index.
+pub const LEAF: u32 = 1 << 31;
+
+/// One inner node: the boxes of up to [`WIDTH`] children in structure-of-arrays lanes.
+///
+/// `bounds[0..3]` are the children's minimum x, y, z, `bounds[3..6]` their maximum x, y, z
+/// (`bounds[axis][k]` is child `k`'s). Unused slots have `min = +inf`, `max = −inf` and
+/// `child = EMPTY`. 224 bytes, aligned to 32.
+#[repr(C, align(32))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Node {
+    /// Children's boxes: min x, y, z, then max x, y, z; lane `k` is child `k`.
+    pub bounds: [[f32; WIDTH]; 6],
+    /// Children: [`EMPTY`], `LEAF | leaf index`, or an inner node's index (greater than this
+    /// node's).
+    pub child: [u32; WIDTH],
+}
+
+impl Node {
+    /// A node with no children.
+    pub const EMPTY: Node = Node {
+        bounds: [
+            [f32::INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+        ],
+        child: [EMPTY; WIDTH],
+    };
+}
+
+impl Default for Node {
+    fn default() -> Self {
+        Node::EMPTY
+    }
+}
+
+/// The builder's working memory for one primitive (56 bytes; not needed after the build).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Scratch {
+    pub(crate) lo: [f32; 3],
+    pub(crate) hi: [f32; 3],
+    pub(crate) c: [f32; 3],
+    pub(crate) index: u32,
+    pub(crate) job: [u32; 4],
+}
+
+/// Storage sizes for a tree over `n` primitives (upper bounds; [`Bvh::nodes`] and
+/// [`Bvh::leaves`] give what a build used, so a host can keep only that).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Sizes {
+    /// [`Node`]s.
+    pub nodes: usize,
+    /// Leaves ([`Tri4`] or [`Sphere4`]).
+    pub leaves: usize,
+    /// [`Scratch`] entries.
+    pub scratch: usize,
+}
+
+/// The storage a tree over `n` primitives needs: `max(n, 1)` nodes (every inner node but the
+/// root has at least two children, every leaf at least one primitive), `n` leaves, `n`
+/// scratch entries.
+#[must_use]
+pub const fn needed(n: usize) -> Sizes {
+    Sizes {
+        nodes: if n == 0 { 1 } else { n },
+        leaves: n,
+        scratch: n,
+    }
+}
+
+/// Why a build failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BuildError {
+    /// Fewer nodes than [`needed`] gives (the value is the number needed).
+    Nodes(usize),
+    /// Fewer leaves than [`needed`] gives.
+    Leaves(usize),
+    /// Less scratch than [`needed`] gives.
+    Scratch(usize),
+    /// More than [`MAX_PRIMITIVES`].
+    TooMany,
+    /// [`refit`]: the leaves do not match the primitives (an index out of range).
+    Mismatch,
+}
+
+impl core::fmt::Display for BuildError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            BuildError::Nodes(n) => write!(f, "BVH build needs {n} nodes"),
+            BuildError::Leaves(n) => write!(f, "BVH build needs {n} leaves"),
+            BuildError::Scratch(n) => write!(f, "BVH build needs {n} scratch entries"),
+            BuildError::TooMany => write!(f, "BVH build: more than 2^30 - 1 primitives"),
+            BuildError::Mismatch => write!(f, "BVH refit: leaves do not match the primitives"),
+        }
+    }
+}
+
+/// A built hierarchy: nodes and leaves borrowed from the caller.
+#[derive(Clone, Copy, Debug)]
+pub struct Bvh<'s, P: Packed> {
+    pub(crate) nodes: &'s [Node],
+    pub(crate) leaves: &'s [P],
+    /// The largest coordinate magnitude of the root's children (`R` in the margin).
+    pub(crate) reach: f32,
+    pub(crate) cull: Cull,
+}
+
+/// A BVH over triangles ([`Watertight`](crate::triangle::Watertight) kernel).
+pub type TriangleBvh<'s> = Bvh<'s, Tri4>;
+/// A BVH over spheres ([`Robust`](crate::sphere::Robust) kernel).
+pub type SphereBvh<'s> = Bvh<'s, Sphere4>;
+
+impl<'s, P: Packed> Bvh<'s, P> {
+    /// Reopens a tree from its two slices (e.g. `static` data built on a host). Returns `None`
+    /// when the slices are not a tree as [`build`] makes them: no nodes, a child index out of
+    /// range, an inner child not after its parent, a node reached twice, or a depth above
+    /// [`MAX_DEPTH`] (linear in the number of nodes).
+    #[must_use]
+    pub fn from_parts(nodes: &'s [Node], leaves: &'s [P]) -> Option<Self> {
+        if nodes.is_empty() {
+            return None;
+        }
+        for (i, n) in nodes.iter().enumerate() {
+            for &c in &n.child {
+                let ok = if c == EMPTY {
+                    true
+                } else if c & LEAF != 0 {
+                    ((c & !LEAF) as usize) < leaves.len()
+                } else {
+                    (c as usize) > i && (c as usize) < nodes.len()
+                };
+                if !ok {
+                    return None;
+                }
+            }
+        }
+        depth(nodes)?;
+        Some(Bvh {
+            nodes,
+            leaves,
+            reach: reach(&nodes[0]),
+            cull: Cull::None,
+        })
+    }
+
+    /// The same tree with back faces culled or not (triangles; spheres ignore it).
+    #[must_use]
+    pub fn with_cull(self, cull: Cull) -> Self {
+        Bvh { cull, ..self }
+    }
+
+    /// The nodes (root first).
+    #[must_use]
+    pub fn nodes(&self) -> &'s [Node] {
+        self.nodes
+    }
+
+    /// The leaves.
+    #[must_use]
+    pub fn leaves(&self) -> &'s [P] {
+        self.leaves
+    }
+
+    /// Depth, node and leaf counts and SAH cost of the tree (walks every node).
+    #[must_use]
+    pub fn stats(&self) -> Stats {
+        let root_area = {
+            let n = &self.nodes[0];
+            let mut lo = [f32::INFINITY; 3];
+            let mut hi = [f32::NEG_INFINITY; 3];
+            for k in 0..WIDTH {
+                for a in 0..3 {
+                    lo[a] = min(lo[a], n.bounds[a][k]);
+                    hi[a] = max(hi[a], n.bounds[3 + a][k]);
+                }
+            }
+            area(lo, hi) as f64
+        };
+        let mut sah = 1.0f64; // the root's traversal
+        let mut prims = 0usize;
+        for n in self.nodes {
+            for k in 0..WIDTH {
+                let c = n.child[k];
+                if c == EMPTY {
+                    continue;
+                }
+                let lo = [n.bounds[0][k], n.bounds[1][k], n.bounds[2][k]];
+                let hi = [n.bounds[3][k], n.bounds[4][k], n.bounds[5][k]];
+                let rel = if root_area > 0.0 {
+                    area(lo, hi) as f64 / root_area
+                } else {
+                    1.0
+                };
+                if c & LEAF != 0 {
+                    let count = self
+                        .leaves
+                        .get((c & !LEAF) as usize)
+                        .map_or(0, |l| l.indices().iter().filter(|&&i| i != EMPTY).count());
+                    prims += count;
+                    sah += rel * count as f64;
+                } else {
+                    sah += rel;
+                }
+            }
+        }
+        let max_depth = depth(self.nodes).unwrap_or(0);
+        Stats {
+            nodes: self.nodes.len(),
+            leaves: self.leaves.len(),
+            primitives: prims,
+            depth: max_depth,
+            sah,
+            bytes: core::mem::size_of_val(self.nodes) + core::mem::size_of_val(self.leaves),
+        }
+    }
+}
+
+/// The depth of the tree under `nodes[0]` (the root alone is 1), or `None` when a node is
+/// reached twice (more visits than nodes), the depth exceeds [`MAX_DEPTH`], or an inner
+/// child does not follow its parent.
+fn depth(nodes: &[Node]) -> Option<u32> {
+    let mut stack = [(0u32, 1u32); STACK];
+    let (mut sp, mut visits, mut deepest) = (1usize, 0usize, 0u32);
+    while sp > 0 {
+        sp -= 1;
+        let (i, d) = stack[sp];
+        visits += 1;
+        if visits > nodes.len() || d > MAX_DEPTH {
+            return None;
+        }
+        deepest = deepest.max(d);
+        for &c in &nodes.get(i as usize)?.child {
+            if c != EMPTY && c & LEAF == 0 {
+                if c <= i {
+                    return None;
+                }
+                *stack.get_mut(sp)? = (c, d + 1);
+                sp += 1;
+            }
+        }
+    }
+    Some(deepest)
+}
+
+/// What [`Bvh::stats`] reports.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stats {
+    /// Inner nodes.
+    pub nodes: usize,
+    /// Leaves.
+    pub leaves: usize,
+    /// Primitives in the leaves.
+    pub primitives: usize,
+    /// Inner-node levels (the root alone is 1).
+    pub depth: u32,
+    /// SAH cost relative to the root's area: `1 + Σ A(inner child)/A(root) + Σ A(leaf)/A(root)·n(leaf)`
+    /// (traversal and intersection weighted 1).
+    pub sah: f64,
+    /// Bytes of nodes and leaves.
+    pub bytes: usize,
+}
+
+/// `a < b ? a : b` (NaN in `b` ignored).
+#[inline(always)]
+pub(crate) fn min(a: f32, b: f32) -> f32 {
+    if b < a { b } else { a }
+}
+
+/// `a > b ? a : b` (NaN in `b` ignored).
+#[inline(always)]
+pub(crate) fn max(a: f32, b: f32) -> f32 {
+    if b > a { b } else { a }
+}
+
+/// Half the surface area of a box; 0 for an empty or NaN box (extents below 0 count as 0).
+#[inline]
+pub(crate) fn area(lo: [f32; 3], hi: [f32; 3]) -> f32 {
+    let e = |a: usize| {
+        let x = hi[a] - lo[a];
+        if x > 0.0 { x } else { 0.0 }
+    };
+    let (x, y, z) = (e(0), e(1), e(2));
+    x * y + y * z + z * x
+}
+
+/// The largest finite coordinate magnitude of a node's non-empty children (`+inf` when a box
+/// has an infinite coordinate, which sends every ray to the visit-all path).
+pub(crate) fn reach(n: &Node) -> f32 {
+    let mut r = 0.0f32;
+    for k in 0..WIDTH {
+        if n.child[k] == EMPTY {
+            continue;
+        }
+        for a in 0..6 {
+            r = max(r, n.bounds[a][k].abs());
+        }
+    }
+    r
+}
