@@ -4,9 +4,13 @@
 //! the positions); nothing is copied or allocated. A triangle with an index out of range is
 //! skipped (never a panic), and one with a non-finite vertex or zero area is never hit (see
 //! [`Triangle::new`]). The index in a hit record is the triangle's position in `indices`;
-//! `u` weighs its vertex B and `v` its vertex C. Each query builds the triangles from the
-//! slices as it goes (with `Triangle::new`'s exact zero-area check: a few `f64` operations per
-//! triangle and packet); the focal cache is built once per eye.
+//! `u` weighs its vertex B and `v` its vertex C.
+//!
+//! **Validated once.** [`Mesh::new`] and [`Mesh::bounded`] check every triangle once (index
+//! range, finite vertices, and [`Triangle::new`]'s exact zero-area test in `f64`) and remember
+//! the invalid ones (up to [`Mesh::LISTED`] of them); queries then only gather the vertices.
+//! A mesh with more invalid triangles than that re-checks each triangle per query (correct,
+//! slower; [`Mesh::invalid`] says how many there are). The focal cache is built once per eye.
 //!
 //! Every triangle kernel runs over a mesh: [`Mesh::closest`], [`Mesh::any`], [`Mesh::all`]
 //! (ray packets, N rays × 1 triangle) and [`Mesh::closest_soa`], [`Mesh::any_soa`] (one ray,
@@ -21,8 +25,9 @@
 use glam::Vec3;
 
 use crate::bounds::{self, Bound};
-use crate::hit::{self, Hit, HitRecord, LaneHit};
+use crate::hit::{self, Best, Hit, HitRecord, LaneHit};
 use crate::lane::{Lane, Mask};
+use crate::query::{self, Hits, Query, TooSmall, Using};
 use crate::ray::{Ray, RayPacket};
 use crate::sphere::focal::{Focal, FocalKernel, Splat};
 use crate::sphere::{FocalSphere, Sphere};
@@ -35,6 +40,10 @@ pub struct Mesh<'a> {
     positions: &'a [Vec3],
     indices: &'a [[u32; 3]],
     bound: Option<Bound>,
+    /// How many triangles are invalid (never hit).
+    invalid: usize,
+    /// The first [`Mesh::LISTED`] of them, ascending.
+    listed: [u32; Mesh::LISTED],
 }
 
 /// Empties the interval of the lanes outside `keep`.
@@ -51,11 +60,66 @@ impl<'a> Mesh<'a> {
     /// A mesh without a bounding sphere.
     #[must_use]
     pub fn new(positions: &'a [Vec3], indices: &'a [[u32; 3]]) -> Self {
-        Mesh {
+        let mut m = Mesh {
             positions,
             indices,
             bound: None,
+            invalid: 0,
+            listed: [u32::MAX; Mesh::LISTED],
+        };
+        for i in 0..indices.len() {
+            if !m.triangle(i).is_some_and(|t| t.is_valid()) {
+                if let Some(slot) = m.listed.get_mut(m.invalid) {
+                    *slot = i as u32;
+                }
+                m.invalid += 1;
+            }
         }
+        m
+    }
+
+    /// How many invalid triangles a mesh lists (and so skips without re-checking).
+    pub const LISTED: usize = 16;
+
+    /// The number of invalid triangles (out-of-range index, non-finite vertex or zero area):
+    /// they are never hit.
+    #[inline]
+    #[must_use]
+    pub fn invalid(&self) -> usize {
+        self.invalid
+    }
+
+    /// Triangle `i` for a query: checked once when the mesh was built (a triangle that is
+    /// never hit when invalid or out of range).
+    #[inline(always)]
+    pub(crate) fn prepared(&self, i: usize) -> Triangle {
+        if self.invalid > Self::LISTED {
+            return self.triangle(i).unwrap_or(Triangle::never());
+        }
+        let Some(&[a, b, c]) = self.indices.get(i) else {
+            return Triangle::never();
+        };
+        let p = |k: u32| self.positions.get(k as usize).copied();
+        let listed = || {
+            self.listed
+                .iter()
+                .take(self.invalid)
+                .any(|&j| j as usize == i)
+        };
+        match (p(a), p(b), p(c)) {
+            (Some(a), Some(b), Some(c)) if self.invalid == 0 || !listed() => {
+                Triangle::valid(a, b, c)
+            }
+            _ => Triangle::never(),
+        }
+    }
+
+    /// The number of focal cache entries [`focus_into`](Self::focus_into) needs: one per
+    /// triangle.
+    #[inline]
+    #[must_use]
+    pub fn needed(&self) -> usize {
+        self.len()
     }
 
     /// A mesh with Ritter's bounding sphere of its referenced vertices (one pass over the
@@ -133,7 +197,7 @@ impl<'a> Mesh<'a> {
 
     /// The rays with culled (and invalid) lanes emptied, or `None` when no lane is left.
     #[inline]
-    fn culled<L: Lane>(&self, rays: &RayPacket<L>) -> Option<RayPacket<L>> {
+    pub(crate) fn kept<L: Lane>(&self, rays: &RayPacket<L>) -> Option<RayPacket<L>> {
         if self.bound.is_none() {
             return Some(*rays);
         }
@@ -158,10 +222,10 @@ impl<'a> Mesh<'a> {
         rays: &RayPacket<L>,
         cull: Cull,
     ) -> Option<Hit<L>> {
-        let r = self.culled(rays)?;
+        let r = self.kept(rays)?;
         let pre = K::prepare(&r);
         Some(hit::closest(&r, 0..self.len(), |r, i| {
-            let t = self.triangle(i)?;
+            let t = self.prepared(i);
             Some(K::intersect(r, &pre, &TrianglePacket::splat(&t), cull))
         }))
     }
@@ -170,12 +234,12 @@ impl<'a> Mesh<'a> {
     #[inline]
     #[must_use]
     pub fn any<K: TriangleKernel, L: Lane>(&self, rays: &RayPacket<L>, cull: Cull) -> L::Mask {
-        let Some(r) = self.culled(rays) else {
+        let Some(r) = self.kept(rays) else {
             return Mask::splat(false);
         };
         let pre = K::prepare(&r);
         hit::any(&r, 0..self.len(), |r, i| {
-            let t = self.triangle(i)?;
+            let t = self.prepared(i);
             Some(K::intersect(r, &pre, &TrianglePacket::splat(&t), cull))
         })
     }
@@ -188,10 +252,10 @@ impl<'a> Mesh<'a> {
         cull: Cull,
         mut f: impl FnMut(u32, &LaneHit<L>),
     ) {
-        let Some(r) = self.culled(rays) else { return };
+        let Some(r) = self.kept(rays) else { return };
         let pre = K::prepare(&r);
         for i in 0..self.len() {
-            let Some(t) = self.triangle(i) else { continue };
+            let t = self.prepared(i);
             let h = K::intersect(&r, &pre, &TrianglePacket::splat(&t), cull);
             if h.mask.any() {
                 f(i as u32, &h.normalized());
@@ -202,7 +266,7 @@ impl<'a> Mesh<'a> {
     /// Triangles `c·L::LANES ..` gathered into lanes (skipped ones never hit).
     #[inline]
     fn chunk<L: Lane>(&self, c: usize) -> TrianglePacket<L> {
-        TrianglePacket::from_fn(|j| self.triangle(c * L::LANES + j).unwrap_or(Triangle::never()))
+        TrianglePacket::from_fn(|j| self.prepared(c * L::LANES + j))
     }
 
     /// Closest hit of one ray, triangles gathered `L::LANES` at a time (1 ray × N).
@@ -234,6 +298,22 @@ impl<'a> Mesh<'a> {
     }
 
     /// Builds the focal cache of every triangle for rays from `eye` into `out` (entry `i` for
+    /// triangle `i`, [`needed`](Self::needed) entries) and returns the cached mesh, which owns
+    /// `eye`: its queries answer rays from `eye` only. `out` shorter than
+    /// [`needed`](Self::needed) is an error (nothing is built).
+    pub fn focus_into<'c>(
+        &self,
+        eye: Vec3,
+        out: &'c mut [FocalTriangle<f32>],
+    ) -> Result<FocalMesh<'c>, TooSmall> {
+        let needed = self.needed();
+        match out.get_mut(..needed) {
+            Some(out) => Ok(self.focus(eye, out)),
+            None => Err(TooSmall { needed }),
+        }
+    }
+
+    /// Builds the focal cache of every triangle for rays from `eye` into `out` (entry `i` for
     /// triangle `i`; skipped triangles get entries that are never hit) and returns the cached
     /// mesh over the entries written (`min(len, out.len())`). Entries are built from the shared
     /// positions, which makes shared edges watertight.
@@ -248,6 +328,8 @@ impl<'a> Mesh<'a> {
         FocalMesh {
             cache: &out[..n],
             bound: self.bound.map(|b| b.focal(eye)),
+            eye,
+            cull: Cull::None,
         }
     }
 }
@@ -258,6 +340,10 @@ impl<'a> Mesh<'a> {
 pub struct FocalMesh<'c> {
     cache: &'c [FocalTriangle<f32>],
     bound: Option<FocalSphere<f32>>,
+    /// The eye the entries were built for: queries answer rays from it only.
+    eye: Vec3,
+    /// The culling of [`Query`] calls.
+    cull: Cull,
 }
 
 impl<'c> FocalMesh<'c> {
@@ -265,7 +351,31 @@ impl<'c> FocalMesh<'c> {
     /// a bound.
     #[must_use]
     pub fn new(cache: &'c [FocalTriangle<f32>]) -> Self {
-        FocalMesh { cache, bound: None }
+        let eye = cache
+            .iter()
+            .find_map(|e| e.eye())
+            .unwrap_or(Vec3::splat(f32::NAN));
+        FocalMesh {
+            cache,
+            bound: None,
+            eye,
+            cull: Cull::None,
+        }
+    }
+
+    /// The eye: through [`Query`], rays from elsewhere (an origin not exactly equal to it)
+    /// are a miss, never an answer for the wrong rays. NaN for a cache without a valid entry.
+    #[inline]
+    #[must_use]
+    pub fn eye(&self) -> Vec3 {
+        self.eye
+    }
+
+    /// The same cache with [`Query`] calls culled ([`Cull::Back`]: front faces only).
+    #[inline]
+    #[must_use]
+    pub fn culled(self, cull: Cull) -> Self {
+        FocalMesh { cull, ..self }
     }
 
     /// The entries.
@@ -291,7 +401,7 @@ impl<'c> FocalMesh<'c> {
 
     /// The rays with culled (and invalid) lanes emptied, or `None` when no lane is left.
     #[inline]
-    fn culled<L: Lane>(&self, rays: &FocalRays<L>) -> Option<FocalRays<L>> {
+    fn kept<L: Lane>(&self, rays: &FocalRays<L>) -> Option<FocalRays<L>> {
         if self.bound.is_none() {
             return Some(*rays);
         }
@@ -314,7 +424,7 @@ impl<'c> FocalMesh<'c> {
     #[inline]
     #[must_use]
     pub fn try_closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Option<Hit<L>> {
-        self.culled(rays)
+        self.kept(rays)
             .map(|r| tf::closest_prepared(&r, self.cache, cull))
     }
 
@@ -322,7 +432,7 @@ impl<'c> FocalMesh<'c> {
     #[inline]
     #[must_use]
     pub fn any<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> L::Mask {
-        match self.culled(rays) {
+        match self.kept(rays) {
             Some(r) => hit::any(&r.scaled, self.cache, |r, e| {
                 tf::maybe_hit(r, &tf::Splat(e), cull)
             }),
@@ -333,8 +443,94 @@ impl<'c> FocalMesh<'c> {
     /// Every hit: `f(triangle index, hit)` for each triangle some lane hits.
     #[inline]
     pub fn all<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull, f: impl FnMut(u32, &LaneHit<L>)) {
-        if let Some(r) = self.culled(rays) {
+        if let Some(r) = self.kept(rays) {
             tf::all_prepared(&r, self.cache, cull, f);
         }
+    }
+}
+
+/// Meshes with kernel `K`: the bounding sphere first (lanes it excludes miss), then N rays × 1
+/// triangle in index order; `all` in index order.
+impl<K: TriangleKernel> Query for Using<'_, Mesh<'_>, K> {
+    #[inline]
+    fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
+        let (m, cull) = (self.set(), self.cull());
+        let Some(r) = m.kept(rays) else {
+            return Hits::none();
+        };
+        let pre = K::prepare(&r);
+        let best = hit::closest(&r, 0..m.len(), |r, i| {
+            Some(K::intersect(
+                r,
+                &pre,
+                &TrianglePacket::splat(&m.prepared(i)),
+                cull,
+            ))
+        });
+        Hits::from_triangles(&r, &best, cull, |i| Some(m.prepared(i as usize)))
+    }
+
+    #[inline]
+    fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
+        self.set().any::<K, L>(rays, self.cull())
+    }
+
+    fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
+        let (m, cull) = (self.set(), self.cull());
+        m.all::<K, L>(rays, cull, |i, h| {
+            let best = Best::single(h, i);
+            f(&Hits::from_triangles(rays, &best, cull, |i| {
+                Some(m.prepared(i as usize))
+            }));
+        });
+    }
+}
+
+/// Meshes with the default kernel, [`Watertight`](crate::triangle::Watertight) (two-sided).
+impl Query for Mesh<'_> {
+    #[inline]
+    fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
+        Using::<_, crate::triangle::Watertight>::new(self).closest_packet(rays)
+    }
+    #[inline]
+    fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
+        Using::<_, crate::triangle::Watertight>::new(self).any_packet(rays)
+    }
+    #[inline]
+    fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
+        Using::<_, crate::triangle::Watertight>::new(self).all_packet(rays, f)
+    }
+}
+
+/// Focal meshes: rays whose origin is not exactly the cache's eye miss (see
+/// [`FocalMesh::eye`]); the others are prepared once ([`FocalRays`]), culled by the bound, and
+/// tested against the entries in index order (two passes per block, as
+/// [`hit::closest_filtered`]). Culling: [`FocalMesh::culled`].
+impl Query for FocalMesh<'_> {
+    #[inline]
+    fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
+        let r = query::at_eye(rays, self.eye);
+        let best = self
+            .try_closest(&FocalRays::new(&r), self.cull)
+            .unwrap_or_else(Best::none);
+        Hits::from_triangles(&r, &best, self.cull, |i| {
+            self.cache.get(i as usize).map(|e| e.triangle())
+        })
+    }
+
+    #[inline]
+    fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
+        let r = query::at_eye(rays, self.eye);
+        FocalMesh::any(self, &FocalRays::new(&r), self.cull)
+    }
+
+    fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
+        let r = query::at_eye(rays, self.eye);
+        FocalMesh::all(self, &FocalRays::new(&r), self.cull, |i, h| {
+            let best = Best::single(h, i);
+            f(&Hits::from_triangles(&r, &best, self.cull, |i| {
+                self.cache.get(i as usize).map(|e| e.triangle())
+            }));
+        });
     }
 }

@@ -418,7 +418,7 @@ pub fn sphere_hit<L: Lane>(roots: &Roots<L>, cull: Cull) -> LaneHit<L> {
 /// Rays a kernel can answer: for the unit-direction kernels, lanes whose `|d|²` is more than
 /// [`UNIT_TOLERANCE`] from 1 get the empty interval (a miss); others unchanged.
 #[inline(always)]
-fn admit<L: Lane>(rays: &RayPacket<L>, unit_directions: bool) -> RayPacket<L> {
+pub(crate) fn admit<L: Lane>(rays: &RayPacket<L>, unit_directions: bool) -> RayPacket<L> {
     if !unit_directions {
         return *rays;
     }
@@ -427,6 +427,28 @@ fn admit<L: Lane>(rays: &RayPacket<L>, unit_directions: bool) -> RayPacket<L> {
     RayPacket {
         t_min: L::select(ok, rays.t_min, L::from_f32(f32::INFINITY)),
         t_max: L::select(ok, rays.t_max, L::from_f32(f32::NEG_INFINITY)),
+        ..*rays
+    }
+}
+
+/// Caller storage too small for a result: `needed` entries are required (e.g.
+/// [`Mesh::focus_into`](crate::mesh::Mesh::focus_into); nothing was written).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TooSmall {
+    /// The number of entries the storage must hold.
+    pub needed: usize,
+}
+
+/// The rays of a focal cache's query: lanes whose origin is not exactly `eye` get the empty
+/// interval (a documented miss; 3 cmp per query).
+#[inline(always)]
+pub(crate) fn at_eye<L: Lane>(rays: &RayPacket<L>, eye: Vec3) -> RayPacket<L> {
+    let e = V3::<L>::splat(eye);
+    let o = rays.origin;
+    let same = o.x.ge(e.x) & o.x.le(e.x) & o.y.ge(e.y) & o.y.le(e.y) & o.z.ge(e.z) & o.z.le(e.z);
+    RayPacket {
+        t_min: L::select(same, rays.t_min, L::from_f32(f32::INFINITY)),
+        t_max: L::select(same, rays.t_max, L::from_f32(f32::NEG_INFINITY)),
         ..*rays
     }
 }

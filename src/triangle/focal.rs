@@ -291,6 +291,27 @@ impl FocalTriangle<f32> {
     }
 }
 
+impl FocalTriangle<f32> {
+    /// The eye the entry was built for (`None` for an entry that is never hit).
+    #[inline]
+    #[must_use]
+    pub fn eye(&self) -> Option<Vec3> {
+        let e: Vec3 = self.e.into();
+        e.is_finite().then_some(e)
+    }
+
+    /// The triangle (one that is never hit for such an entry).
+    #[inline]
+    #[must_use]
+    pub fn triangle(&self) -> Triangle {
+        Triangle {
+            a: self.a.into(),
+            b: self.b.into(),
+            c: self.c.into(),
+        }
+    }
+}
+
 impl<L: Lane> FocalTriangle<L> {
     /// The same entry in every lane (N rays × 1 triangle).
     #[inline(always)]

@@ -145,6 +145,13 @@ impl Triangle {
         }
     }
 
+    /// A triangle already known to be valid (finite, nonzero area): no check.
+    #[inline(always)]
+    #[must_use]
+    pub(crate) fn valid(a: Vec3, b: Vec3, c: Vec3) -> Self {
+        Triangle { a, b, c }
+    }
+
     /// A triangle that is never hit (NaN vertices).
     #[must_use]
     pub const fn never() -> Self {

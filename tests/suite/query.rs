@@ -263,3 +263,69 @@ fn plane_and_scene_queries_every_lane_equals_one_ray() {
         assert!(sets.contains(&k), "no hit of set {k}");
     }
 }
+
+#[test]
+fn mesh_and_focal_mesh_queries_every_lane_equals_one_ray() {
+    use raylane::mesh::Mesh;
+    use raylane::query::TooSmall;
+    use raylane::triangle::FocalTriangle;
+    let m = load_bin(include_bytes!("../data/bunny.bin"));
+    // Two invalid triangles (an index out of range, a zero-area one): listed once, never hit.
+    let mut idx = m.idx.clone();
+    idx.push([0, 0, 1]);
+    idx.push([0, 1, u32::MAX]);
+    let tris: Vec<Triangle> = idx
+        .iter()
+        .map(|t| {
+            let p = |k: u32| m.pos.get(k as usize).copied();
+            match (p(t[0]), p(t[1]), p(t[2])) {
+                (Some(a), Some(b), Some(c)) => Triangle::new(a, b, c),
+                _ => Triangle::never(),
+            }
+        })
+        .collect();
+    let mesh = Mesh::new(&m.pos, &idx);
+    assert_eq!(mesh.invalid(), 2);
+    let bounded = Mesh::bounded(&m.pos, &idx);
+    let (lo, hi) = m
+        .pos
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
+            (l.min(*p), h.max(*p))
+        });
+    let (c, size) = ((lo + hi) / 2.0, (hi - lo).length() / 2.0);
+    let mut rng = SmallRng::seed_from_u64(14);
+    let rays: Vec<Ray> = (0..120).map(|_| ray(&mut rng, c, size)).collect();
+    let want = every_width(&tris[..], &rays, "triangles");
+    for (q, what) in [(mesh, "mesh"), (bounded, "bounded mesh")] {
+        let got = every_width(&q, &rays, what);
+        assert_eq!(
+            got.iter().map(|h| bits(*h)).collect::<Vec<_>>(),
+            want.iter().map(|h| bits(*h)).collect::<Vec<_>>(),
+            "{what} vs the same triangles"
+        );
+    }
+    // Focal: rays from the eye; rays from elsewhere are a miss.
+    let eye = c + Vec3::new(0.2, 0.3, 2.0) * size;
+    let mut cache = vec![FocalTriangle::never(); mesh.needed()];
+    assert_eq!(
+        mesh.focus_into(eye, &mut cache[..10]).err(),
+        Some(TooSmall { needed: idx.len() })
+    );
+    let fm = bounded.focus_into(eye, &mut cache).unwrap();
+    let from_eye: Vec<Ray> = (0..160)
+        .map(|_| Ray::new(eye, (c + vec(&mut rng, 0.6 * size) - eye).normalize()))
+        .collect();
+    let hits = every_width(&fm, &from_eye, "focal mesh");
+    assert!(hits.iter().flatten().count() > 40);
+    for (r, h) in from_eye.iter().zip(&hits) {
+        // The same surface as Watertight, nearly the same t (different kernels).
+        let w = tris.closest(r);
+        assert_eq!(h.map(|h| h.index), w.map(|w| w.index), "{r:?}");
+        let elsewhere = Ray::new(r.origin() + Vec3::X * 1e-3, r.dir());
+        assert_eq!(Query::closest(&fm, &elsewhere), None);
+        assert!(!Query::any(&fm, &elsewhere));
+    }
+    let culled = every_width(&fm.culled(Cull::Back), &from_eye, "culled focal mesh");
+    assert!(culled.iter().flatten().all(|h| h.front));
+}
