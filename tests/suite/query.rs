@@ -329,3 +329,67 @@ fn mesh_and_focal_mesh_queries_every_lane_equals_one_ray() {
     let culled = every_width(&fm.culled(Cull::Back), &from_eye, "culled focal mesh");
     assert!(culled.iter().flatten().all(|h| h.front));
 }
+
+#[test]
+fn focal_spheres_and_planes_own_their_eye() {
+    use raylane::Dir;
+    use raylane::plane::{FocalPlane, FocalPlanes};
+    use raylane::query::TooSmall;
+    use raylane::sphere::FocalSphere;
+    use raylane::sphere::focal::FocalSpheres;
+    let mut rng = SmallRng::seed_from_u64(15);
+    let s = spheres(&mut rng, 20);
+    let planes: Vec<Plane> = (0..4)
+        .map(|_| Plane::new(vec(&mut rng, 8.0), vec(&mut rng, 2.0)))
+        .collect();
+    let eye = Vec3::new(1.0, 2.0, 12.0);
+    let mut sc = vec![FocalSphere::pass_all(); FocalSpheres::needed(&s)];
+    assert_eq!(
+        FocalSpheres::focus(eye, &s, &mut sc[..3]).err(),
+        Some(TooSmall { needed: 20 })
+    );
+    let fs = FocalSpheres::focus(eye, &s, &mut sc).unwrap();
+    let mut pc = vec![FocalPlane::new(eye, &planes[0]); FocalPlanes::needed(&planes)];
+    let fp = FocalPlanes::focus(eye, &planes, &mut pc).unwrap();
+    let rays: Vec<Ray> = (0..160)
+        .map(|_| match Dir::new(vec(&mut rng, 8.0) - eye) {
+            Some(d) => Ray::unit(eye, d),
+            None => Ray::new(eye, Vec3::ZERO),
+        })
+        .collect();
+    let hits = every_width(&fs, &rays, "focal spheres");
+    assert!(hits.iter().flatten().count() > 20);
+    for (r, h) in rays.iter().zip(&hits) {
+        // The same sphere and face as Robust, t within the focal kernel's 2^-16.
+        let w = s.closest(r);
+        assert_eq!(
+            h.map(|h| (h.index, h.front)),
+            w.map(|w| (w.index, w.front)),
+            "{r:?}"
+        );
+        if let (Some(h), Some(w)) = (h, w) {
+            assert!((h.t - w.t).abs() <= w.t * 1.0 / 65536.0);
+        }
+        // Not from the eye, or not unit length: a miss.
+        let moved = Ray::new(r.origin() + Vec3::Y, r.dir());
+        let long = Ray::new(r.origin(), r.dir() * 1.5);
+        assert_eq!((fs.closest(&moved), fs.closest(&long)), (None, None));
+        assert!(!fs.any(&moved) && !fs.any(&long));
+    }
+    every_width(&fs.culled(Cull::Back), &rays, "culled focal spheres");
+    let ph = every_width(&fp, &rays, "focal planes");
+    for (r, h) in rays.iter().zip(&ph) {
+        assert_eq!(
+            bits(*h),
+            bits(planes.closest(r)),
+            "focal planes vs planes: {r:?}"
+        );
+        assert_eq!(fp.closest(&Ray::new(r.origin() + Vec3::X, r.dir())), None);
+    }
+    assert_eq!(Dir::new(Vec3::ZERO), None);
+    assert_eq!(
+        Dir::new(Vec3::new(0.0, 3e38, 3e38)).unwrap().get().y,
+        core::f32::consts::FRAC_1_SQRT_2
+    );
+    assert!(Dir::new(Vec3::new(1e-40, 0.0, 0.0)).unwrap().get() == Vec3::X);
+}
