@@ -12,23 +12,37 @@
 //! A mesh with more invalid triangles than that re-checks each triangle per query (correct,
 //! slower; [`Mesh::invalid`] says how many there are). The focal cache is built once per eye.
 //!
-//! Every triangle kernel runs over a mesh: [`Mesh::closest`], [`Mesh::any`], [`Mesh::all`]
-//! (ray packets, N rays × 1 triangle) and [`Mesh::closest_soa`], [`Mesh::any_soa`] (one ray,
-//! triangles gathered into lanes on the fly), two-sided or culled ([`Cull`]).
+//! Queries ([`Query`]): `mesh.closest(&ray)`, `mesh.any(&packet)`, `mesh.all(..)` with the
+//! default kernel ([`Watertight`](crate::triangle::Watertight), two-sided), or
+//! `mesh.using::<K>()` for any other triangle kernel, culled with
+//! [`Using::culled`] ([`Cull`]); N rays × 1 triangle, in index order.
+//!
+//! ```
+//! use raylane::glam::Vec3;
+//! use raylane::mesh::Mesh;
+//! use raylane::{Query, Ray};
+//!
+//! let positions = [Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0)];
+//! let indices = [[0u32, 1, 2]];
+//! let mesh = Mesh::new(&positions, &indices);
+//! let hit = mesh.closest(&Ray::new(Vec3::new(1.0, 1.0, 5.0), Vec3::NEG_Z)).unwrap();
+//! assert_eq!((hit.t, hit.u, hit.normal, hit.front), (5.0, 0.25, Vec3::Z, true));
+//! ```
 //!
 //! **Culling.** [`Mesh::bounded`] adds a bounding sphere ([`bounds`]); each
 //! query first asks [`Bound::may_hit`], and lanes it rejects are not tested (their interval
 //! is emptied, so every lane width gives the scalar answer). For rays from one eye,
-//! [`Mesh::focus`] builds the focal cache ([`FocalTriangle`]) into caller storage, with the
-//! bound as a [`FocalSphere`] tested first.
+//! [`Mesh::focus`] builds the focal cache ([`FocalTriangle`]) into caller storage (too little
+//! is an error, [`Mesh::needed`] says how much), with the bound as a [`FocalSphere`] tested
+//! first; the [`FocalMesh`] owns its eye.
 
 use glam::Vec3;
 
 use crate::bounds::{self, Bound};
-use crate::hit::{self, Best, Hit, HitRecord, LaneHit};
+use crate::hit::{self, Best, Hit, LaneHit};
 use crate::lane::{Lane, Mask};
 use crate::query::{self, Hits, Query, TooSmall, Using};
-use crate::ray::{Ray, RayPacket};
+use crate::ray::RayPacket;
 use crate::sphere::focal::{Focal, FocalKernel, Splat};
 use crate::sphere::{FocalSphere, Sphere};
 use crate::triangle::focal::{self as tf, FocalRays, FocalTriangle};
@@ -114,7 +128,7 @@ impl<'a> Mesh<'a> {
         }
     }
 
-    /// The number of focal cache entries [`focus_into`](Self::focus_into) needs: one per
+    /// The number of focal cache entries [`focus`](Self::focus) needs: one per
     /// triangle.
     #[inline]
     #[must_use]
@@ -205,19 +219,12 @@ impl<'a> Mesh<'a> {
         keep.any().then(|| only(rays, keep))
     }
 
-    /// Closest hit of ray lanes with kernel `K`.
+    /// The closest hit's loop state with kernel `K`, or `None` when the bounding sphere
+    /// excludes every valid lane (then no triangle was tested): for the demo, which counts
+    /// what culling saves.
     #[inline]
     #[must_use]
-    pub fn closest<K: TriangleKernel, L: Lane>(&self, rays: &RayPacket<L>, cull: Cull) -> Hit<L> {
-        self.try_closest::<K, L>(rays, cull)
-            .unwrap_or_else(Hit::none)
-    }
-
-    /// [`closest`](Self::closest), or `None` when the bounding sphere excludes every valid lane
-    /// (then no triangle was tested): for callers that count what culling saves.
-    #[inline]
-    #[must_use]
-    pub fn try_closest<K: TriangleKernel, L: Lane>(
+    pub(crate) fn try_closest<K: TriangleKernel, L: Lane>(
         &self,
         rays: &RayPacket<L>,
         cull: Cull,
@@ -233,7 +240,11 @@ impl<'a> Mesh<'a> {
     /// Lanes whose ray hits some triangle (occlusion), with kernel `K`.
     #[inline]
     #[must_use]
-    pub fn any<K: TriangleKernel, L: Lane>(&self, rays: &RayPacket<L>, cull: Cull) -> L::Mask {
+    pub(crate) fn any_lanes<K: TriangleKernel, L: Lane>(
+        &self,
+        rays: &RayPacket<L>,
+        cull: Cull,
+    ) -> L::Mask {
         let Some(r) = self.kept(rays) else {
             return Mask::splat(false);
         };
@@ -246,7 +257,7 @@ impl<'a> Mesh<'a> {
 
     /// Every hit: `f(triangle index, hit)` for each triangle some lane hits, in index order.
     #[inline]
-    pub fn all<K: TriangleKernel, L: Lane>(
+    pub(crate) fn all_lanes<K: TriangleKernel, L: Lane>(
         &self,
         rays: &RayPacket<L>,
         cull: Cull,
@@ -263,79 +274,38 @@ impl<'a> Mesh<'a> {
         }
     }
 
-    /// Triangles `c·L::LANES ..` gathered into lanes (skipped ones never hit).
-    #[inline]
-    fn chunk<L: Lane>(&self, c: usize) -> TrianglePacket<L> {
-        TrianglePacket::from_fn(|j| self.prepared(c * L::LANES + j))
-    }
-
-    /// Closest hit of one ray, triangles gathered `L::LANES` at a time (1 ray × N).
-    #[inline]
-    #[must_use]
-    pub fn closest_soa<K: TriangleKernel, L: Lane>(
-        &self,
-        ray: &Ray,
-        cull: Cull,
-    ) -> Option<HitRecord> {
-        if !self.may_hit(&RayPacket::<f32>::splat(ray)) {
-            return None;
-        }
-        let pre = K::prepare(&RayPacket::<L>::splat(ray));
-        let chunks = (0..self.len().div_ceil(L::LANES)).map(|c| self.chunk::<L>(c));
-        hit::closest_soa(ray, chunks, |r, t| Some(K::intersect(r, &pre, &t, cull)))
-    }
-
-    /// True when one ray hits some triangle (triangles gathered into lanes).
-    #[inline]
-    #[must_use]
-    pub fn any_soa<K: TriangleKernel, L: Lane>(&self, ray: &Ray, cull: Cull) -> bool {
-        if !self.may_hit(&RayPacket::<f32>::splat(ray)) {
-            return false;
-        }
-        let pre = K::prepare(&RayPacket::<L>::splat(ray));
-        let chunks = (0..self.len().div_ceil(L::LANES)).map(|c| self.chunk::<L>(c));
-        hit::any_soa(ray, chunks, |r, t| Some(K::intersect(r, &pre, &t, cull)))
-    }
-
     /// Builds the focal cache of every triangle for rays from `eye` into `out` (entry `i` for
-    /// triangle `i`, [`needed`](Self::needed) entries) and returns the cached mesh, which owns
-    /// `eye`: its queries answer rays from `eye` only. `out` shorter than
-    /// [`needed`](Self::needed) is an error (nothing is built).
-    pub fn focus_into<'c>(
+    /// triangle `i`, from the shared positions, which makes shared edges watertight; invalid
+    /// triangles get entries that are never hit) and returns the cached mesh, which owns `eye`:
+    /// its queries answer rays from `eye` only. `out` shorter than [`needed`](Self::needed) is
+    /// an error (nothing is built); a longer one is used up to `needed`.
+    pub fn focus<'c>(
         &self,
         eye: Vec3,
         out: &'c mut [FocalTriangle<f32>],
     ) -> Result<FocalMesh<'c>, TooSmall> {
         let needed = self.needed();
-        match out.get_mut(..needed) {
-            Some(out) => Ok(self.focus(eye, out)),
-            None => Err(TooSmall { needed }),
-        }
-    }
-
-    /// Builds the focal cache of every triangle for rays from `eye` into `out` (entry `i` for
-    /// triangle `i`; skipped triangles get entries that are never hit) and returns the cached
-    /// mesh over the entries written (`min(len, out.len())`). Entries are built from the shared
-    /// positions, which makes shared edges watertight.
-    pub fn focus<'c>(&self, eye: Vec3, out: &'c mut [FocalTriangle<f32>]) -> FocalMesh<'c> {
-        let n = self.len().min(out.len());
-        for (i, slot) in out[..n].iter_mut().enumerate() {
+        let Some(out) = out.get_mut(..needed) else {
+            return Err(TooSmall { needed });
+        };
+        for (i, slot) in out.iter_mut().enumerate() {
             *slot = match self.triangle(i) {
                 Some(t) => FocalTriangle::new(eye, &t),
                 None => FocalTriangle::never(),
             };
         }
-        FocalMesh {
-            cache: &out[..n],
+        Ok(FocalMesh {
+            cache: out,
             bound: self.bound.map(|b| b.focal(eye)),
             eye,
             cull: Cull::None,
-        }
+        })
     }
 }
 
-/// A mesh's focal cache for one eye, with its bounding sphere as a [`FocalSphere`]. Queries
-/// take [`FocalRays`] (prepared once per query for any number of meshes).
+/// A mesh's focal cache for one eye, which it owns, with its bounding sphere as a
+/// [`FocalSphere`]: built by [`Mesh::focus`], queried through [`Query`] (rays from the eye
+/// only).
 #[derive(Clone, Copy, Debug)]
 pub struct FocalMesh<'c> {
     cache: &'c [FocalTriangle<f32>],
@@ -412,18 +382,12 @@ impl<'c> FocalMesh<'c> {
         })
     }
 
-    /// Closest hit of rays from the eye.
+    /// The closest hit's loop state for prepared rays from the eye, or `None` when the bounding
+    /// sphere excludes every valid lane (then no triangle was tested): for the demo, which
+    /// counts what culling saves.
     #[inline]
     #[must_use]
-    pub fn closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Hit<L> {
-        self.try_closest(rays, cull).unwrap_or_else(Hit::none)
-    }
-
-    /// [`closest`](Self::closest), or `None` when the bounding sphere excludes every valid lane
-    /// (then no triangle was tested): for callers that count what culling saves.
-    #[inline]
-    #[must_use]
-    pub fn try_closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Option<Hit<L>> {
+    pub(crate) fn try_closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Option<Hit<L>> {
         self.kept(rays)
             .map(|r| tf::closest_prepared(&r, self.cache, cull))
     }
@@ -431,7 +395,7 @@ impl<'c> FocalMesh<'c> {
     /// Lanes whose ray from the eye hits some triangle (occlusion).
     #[inline]
     #[must_use]
-    pub fn any<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> L::Mask {
+    fn any_lanes<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> L::Mask {
         match self.kept(rays) {
             Some(r) => hit::any(&r.scaled, self.cache, |r, e| {
                 tf::maybe_hit(r, &tf::Splat(e), cull)
@@ -442,7 +406,7 @@ impl<'c> FocalMesh<'c> {
 
     /// Every hit: `f(triangle index, hit)` for each triangle some lane hits.
     #[inline]
-    pub fn all<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull, f: impl FnMut(u32, &LaneHit<L>)) {
+    fn all_lanes<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull, f: impl FnMut(u32, &LaneHit<L>)) {
         if let Some(r) = self.kept(rays) {
             tf::all_prepared(&r, self.cache, cull, f);
         }
@@ -472,12 +436,12 @@ impl<K: TriangleKernel> Query for Using<'_, Mesh<'_>, K> {
 
     #[inline]
     fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
-        self.set().any::<K, L>(rays, self.cull())
+        self.set().any_lanes::<K, L>(rays, self.cull())
     }
 
     fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
         let (m, cull) = (self.set(), self.cull());
-        m.all::<K, L>(rays, cull, |i, h| {
+        m.all_lanes::<K, L>(rays, cull, |i, h| {
             let best = Best::single(h, i);
             f(&Hits::from_triangles(rays, &best, cull, |i| {
                 Some(m.prepared(i as usize))
@@ -521,12 +485,12 @@ impl Query for FocalMesh<'_> {
     #[inline]
     fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
         let r = query::at_eye(rays, self.eye);
-        FocalMesh::any(self, &FocalRays::new(&r), self.cull)
+        self.any_lanes(&FocalRays::new(&r), self.cull)
     }
 
     fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
         let r = query::at_eye(rays, self.eye);
-        FocalMesh::all(self, &FocalRays::new(&r), self.cull, |i, h| {
+        self.all_lanes(&FocalRays::new(&r), self.cull, |i, h| {
             let best = Best::single(h, i);
             f(&Hits::from_triangles(&r, &best, self.cull, |i| {
                 self.cache.get(i as usize).map(|e| e.triangle())

@@ -458,7 +458,7 @@ pub(crate) fn admit<L: Lane>(rays: &RayPacket<L>, unit_directions: bool) -> RayP
 }
 
 /// Caller storage too small for a result: `needed` entries are required (e.g.
-/// [`Mesh::focus_into`](crate::mesh::Mesh::focus_into); nothing was written).
+/// [`Mesh::focus`](crate::mesh::Mesh::focus); nothing was written).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct TooSmall {
     /// The number of entries the storage must hold.

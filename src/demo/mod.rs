@@ -570,7 +570,10 @@ impl<'a> Frame<'a> {
                         .split_at_mut_checked(n)
                         .ok_or(SetupError::TriangleStorage)?;
                     tri_store = rest;
-                    Some(mesh.focus(e, head))
+                    Some(
+                        mesh.focus(e, head)
+                            .map_err(|_| SetupError::TriangleStorage)?,
+                    )
                 }
                 None => None,
             };

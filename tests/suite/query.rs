@@ -47,6 +47,17 @@ fn ray(rng: &mut SmallRng, c: Vec3, scale: f32) -> Ray {
     }
 }
 
+/// A query's record as the kernels' record (`t`, `u`, `v`, index), for the tests that compare
+/// with the kernels' own entry points.
+pub fn record(h: Option<Hit>) -> Option<raylane::HitRecord> {
+    h.map(|h| raylane::HitRecord {
+        t: h.t,
+        u: h.u,
+        v: h.v,
+        index: h.index,
+    })
+}
+
 fn bits(h: Option<Hit>) -> Option<[u32; 12]> {
     h.map(|h| {
         [
@@ -309,10 +320,10 @@ fn mesh_and_focal_mesh_queries_every_lane_equals_one_ray() {
     let eye = c + Vec3::new(0.2, 0.3, 2.0) * size;
     let mut cache = vec![FocalTriangle::never(); mesh.needed()];
     assert_eq!(
-        mesh.focus_into(eye, &mut cache[..10]).err(),
+        mesh.focus(eye, &mut cache[..10]).err(),
         Some(TooSmall { needed: idx.len() })
     );
-    let fm = bounded.focus_into(eye, &mut cache).unwrap();
+    let fm = bounded.focus(eye, &mut cache).unwrap();
     let from_eye: Vec<Ray> = (0..160)
         .map(|_| Ray::new(eye, (c + vec(&mut rng, 0.6 * size) - eye).normalize()))
         .collect();

@@ -18,8 +18,8 @@ use raylane::V3;
 use raylane::demo::shapes;
 use raylane::mesh::Mesh;
 use raylane::triangle::{
-    Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout, KenslerShirley,
-    Moller, Plucker, TriangleKernel, Wald, Watertight,
+    Badouel, BaldwinWeber, Cramer, FocalTriangle, HavelHerout, KenslerShirley, Moller, Plucker,
+    TriangleKernel, Wald, Watertight,
 };
 use raylane::{Ray, RayPacket};
 
@@ -313,16 +313,12 @@ fn hits(m: Method, s: &Shape, ray: &Ray, cache: &mut [FocalTriangle<f32>]) -> Ve
     let mesh = Mesh::new(&s.pos, &s.idx);
     let rp = RayPacket::<f32>::splat(ray);
     let mut out = Vec::new();
-    let mut push = |i: u32, h: &raylane::LaneHit<f32>| {
+    let mut push = |h: raylane::Hit| {
         assert!(h.t.is_finite() && h.u.is_finite() && h.v.is_finite());
-        out.push((h.t, i));
+        out.push((h.t, h.index));
     };
-    fn run<K: TriangleKernel>(
-        mesh: &Mesh,
-        rp: &RayPacket<f32>,
-        f: impl FnMut(u32, &raylane::LaneHit<f32>),
-    ) {
-        mesh.all::<K, f32>(rp, Cull::None, f);
+    fn run<K: TriangleKernel>(mesh: &Mesh, rp: &RayPacket<f32>, f: impl FnMut(raylane::Hit)) {
+        raylane::Query::all(&raylane::Using::<_, K>::new(mesh), &rp.ray(0), f);
     }
     match m {
         Method::Cramer => run::<Cramer>(&mesh, &rp, &mut push),
@@ -335,8 +331,8 @@ fn hits(m: Method, s: &Shape, ray: &Ray, cache: &mut [FocalTriangle<f32>]) -> Ve
         Method::KenslerShirley => run::<KenslerShirley>(&mesh, &rp, &mut push),
         Method::BaldwinWeber => run::<BaldwinWeber>(&mesh, &rp, &mut push),
         Method::Focal => {
-            let fm = mesh.focus(ray.origin(), cache);
-            fm.all(&FocalRays::new(&rp), Cull::None, &mut push);
+            let fm = mesh.focus(ray.origin(), cache).unwrap();
+            raylane::Query::all(&fm, ray, &mut push);
         }
     }
     out.sort_by(|a, b| a.0.total_cmp(&b.0));
