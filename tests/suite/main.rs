@@ -5,6 +5,7 @@
 mod accuracy;
 mod bad_input;
 mod bunny;
+mod doc_counts;
 mod exact_ref;
 mod focal_accuracy;
 mod focal_precision;
