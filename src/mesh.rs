@@ -222,6 +222,7 @@ impl<'a> Mesh<'a> {
     /// The closest hit's loop state with kernel `K`, or `None` when the bounding sphere
     /// excludes every valid lane (then no triangle was tested): for the demo, which counts
     /// what culling saves.
+    #[cfg(feature = "demo")]
     #[inline]
     #[must_use]
     pub(crate) fn try_closest<K: TriangleKernel, L: Lane>(
