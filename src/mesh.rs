@@ -39,7 +39,7 @@
 use glam::Vec3;
 
 use crate::bounds::{self, Bound};
-use crate::hit::{self, Best, Hit, LaneHit};
+use crate::hit::{self, Best, LaneHit};
 use crate::lane::{Lane, Mask};
 use crate::query::{self, Hits, Query, TooSmall, Using};
 use crate::ray::RayPacket;
@@ -229,7 +229,7 @@ impl<'a> Mesh<'a> {
         &self,
         rays: &RayPacket<L>,
         cull: Cull,
-    ) -> Option<Hit<L>> {
+    ) -> Option<Best<L>> {
         let r = self.kept(rays)?;
         let pre = K::prepare(&r);
         Some(hit::closest(&r, 0..self.len(), |r, i| {
@@ -388,7 +388,7 @@ impl<'c> FocalMesh<'c> {
     /// counts what culling saves.
     #[inline]
     #[must_use]
-    pub(crate) fn try_closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Option<Hit<L>> {
+    pub(crate) fn try_closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Option<Best<L>> {
         self.kept(rays)
             .map(|r| tf::closest_prepared(&r, self.cache, cull))
     }

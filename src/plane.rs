@@ -148,7 +148,7 @@ pub fn intersect(ray: &Ray, plane: &Plane) -> Option<HitRecord> {
 /// Closest hit of ray lanes over a slice of planes (N rays × 1 plane).
 #[inline]
 #[must_use]
-pub fn closest<L: Lane>(rays: &RayPacket<L>, planes: &[Plane]) -> hit::Hit<L> {
+pub fn closest<L: Lane>(rays: &RayPacket<L>, planes: &[Plane]) -> hit::Best<L> {
     hit::closest(rays, planes, |r, p| {
         Some(intersect_lanes(r, &PlanePacket::splat(p)))
     })
@@ -177,7 +177,7 @@ pub fn all<L: Lane>(rays: &RayPacket<L>, planes: &[Plane], mut f: impl FnMut(u32
 /// Closest hit of ray lanes from the eye over cached planes.
 #[inline]
 #[must_use]
-pub fn closest_focal<L: Lane>(rays: &RayPacket<L>, cache: &[FocalPlane]) -> hit::Hit<L> {
+pub fn closest_focal<L: Lane>(rays: &RayPacket<L>, cache: &[FocalPlane]) -> hit::Best<L> {
     hit::closest(rays, cache, |r, p| Some(p.intersect_lanes(r)))
 }
 

@@ -518,7 +518,7 @@ fn hit_path<L: Lane, S: FocalLanes<L>>(
 pub fn closest<K: FocalKernel, L: Lane>(
     rays: &RayPacket<L>,
     cache: &[FocalSphere<f32>],
-) -> hit::Hit<L> {
+) -> hit::Best<L> {
     hit::closest_filtered(
         rays,
         cache,

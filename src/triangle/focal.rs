@@ -112,7 +112,7 @@ use glam::Vec3;
 
 use super::exact;
 use super::{Cull, Triangle, in_front, within};
-use crate::hit::{self, Hit, HitRecord, LaneHit};
+use crate::hit::{self, Best, HitRecord, LaneHit};
 use crate::lane::{Lane, Mask, Scalar};
 use crate::ray::{Ray, RayPacket};
 use crate::vec3::V3;
@@ -816,7 +816,7 @@ pub fn closest_prepared<L: Lane>(
     rays: &FocalRays<L>,
     cache: &[FocalTriangle<f32>],
     cull: Cull,
-) -> Hit<L> {
+) -> Best<L> {
     // Two passes, the cheap edge test over a block of triangles first.
     let mut best = hit::closest_filtered(
         &rays.scaled,
@@ -831,7 +831,7 @@ pub fn closest_prepared<L: Lane>(
 /// Closest hit of ray packets from the cache's eye over cached triangles (N rays × 1).
 #[inline]
 #[must_use]
-pub fn closest<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull: Cull) -> Hit<L> {
+pub fn closest<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull: Cull) -> Best<L> {
     closest_prepared(&FocalRays::new(rays), cache, cull)
 }
 

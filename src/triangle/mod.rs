@@ -98,7 +98,7 @@ pub use watertight::{Shear, Watertight};
 
 use glam::Vec3;
 
-use crate::hit::{self, Hit, HitRecord, LaneHit};
+use crate::hit::{self, Best, HitRecord, LaneHit};
 use crate::lane::{Lane, Mask};
 use crate::ray::{Ray, RayPacket};
 use crate::vec3::V3;
@@ -396,7 +396,7 @@ pub fn closest<K: TriangleKernel, L: Lane>(
     rays: &RayPacket<L>,
     tris: &[Triangle],
     cull: Cull,
-) -> Hit<L> {
+) -> Best<L> {
     let pre = K::prepare(rays);
     hit::closest(rays, tris, |r, t| {
         Some(K::intersect(r, &pre, &TrianglePacket::splat(t), cull))

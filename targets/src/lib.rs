@@ -12,7 +12,7 @@
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use glam::Vec3;
-use raylane::hit::Hit;
+use raylane::hit::Best;
 use raylane::mesh::Mesh;
 use raylane::plane::{self, FocalPlane, Plane};
 use raylane::registry::{Kernel, Visitor};
@@ -146,7 +146,7 @@ fn sink(bits: u32) {
     unsafe { write_volatile(addr_of_mut!(SINK), read_volatile(addr_of!(SINK)) ^ bits) }
 }
 
-fn hits<L: Lane<Scalar = f32>>(h: &Hit<L>) {
+fn hits<L: Lane<Scalar = f32>>(h: &Best<L>) {
     sink(h.mask.bits() ^ h.t.lane(0).to_bits() ^ h.u.lane(0).to_bits());
 }
 

@@ -26,7 +26,7 @@ use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
-use raylane::hit::{Hit, HitRecord};
+use raylane::hit::{Best, HitRecord};
 use raylane::mesh::Mesh;
 use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
 use raylane::sphere::focal::{self as sf, Focal, FocalKernel, FocalUnguarded};
@@ -525,7 +525,7 @@ fn planes<L: Lane<Scalar = f32>>(c: &Case) {
 fn hits_agree<L: Lane<Scalar = f32>>(
     what: &str,
     rays: &[Ray],
-    h: &Hit<L>,
+    h: &Best<L>,
     one: impl Fn(&Ray) -> Option<HitRecord>,
 ) {
     for (i, ray) in rays.iter().enumerate() {

@@ -10,7 +10,7 @@ use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
 use raylane::demo::shapes;
-use raylane::hit::Hit;
+use raylane::hit::Best;
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
 use raylane::opcount::{OpCounts, table};
@@ -240,7 +240,7 @@ fn exact_fallback_lanes_equal_scalar() {
     fallback_lanes::<f32x16>(3);
 }
 
-fn same_hit<L: Lane<Scalar = f32>>(h: &Hit<L>, i: usize, s: &Hit<f32>, what: &str) {
+fn same_hit<L: Lane<Scalar = f32>>(h: &Best<L>, i: usize, s: &Best<f32>, what: &str) {
     assert_eq!(h.lane(i), s.get(), "{what}: lane {i}");
     if let Some(r) = h.lane(i) {
         assert_eq!(r.t.to_bits(), s.t.to_bits(), "{what}: t bits lane {i}");
