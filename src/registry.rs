@@ -206,13 +206,13 @@ macro_rules! registry {
     )+) => {
         /// A name under which the checker runs kernels over the test vectors (one kernel per
         /// primitive it tests): see the [module docs](self).
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
         pub enum Method {
             $( $(#[doc = $mdoc])* $method, )+
         }
 
         /// One ray–primitive test: see the [module docs](self).
-        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+        #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
         pub enum Kernel {
             $( $( $(#[doc = $kdoc])* $kernel, )+ )+
         }

@@ -623,15 +623,19 @@ fn case_lane(cases: &[Case], i: usize) -> Case {
     cases[i.min(cases.len() - 1)]
 }
 
+// Each family out of line: their caches (up to 16 lanes of focal entries) then never share
+// one stack frame (the Cortex-M0 has 16 KB of RAM).
 impl<L: Lane<Scalar = f32>> Visitor for Batch<'_, L> {
     type Output = ();
 
+    #[inline(never)]
     fn sphere<K: SphereKernel>(self, _: Kernel) {
         let spheres = SpherePacket::<L>::from_spheres(&sphere_list(self.cases));
         let roots = K::roots(&self.ray, &spheres);
         self.roots(roots);
     }
 
+    #[inline(never)]
     fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) {
         // A per-case cache with the eye at the ray origin.
         let mut e =
@@ -648,6 +652,7 @@ impl<L: Lane<Scalar = f32>> Visitor for Batch<'_, L> {
         self.roots(roots);
     }
 
+    #[inline(never)]
     fn plane(self, _: Kernel) {
         let planes = PlanePacket::<L> {
             point: V3::from_fn(|i| self.get(i).vec(0)),
@@ -657,6 +662,7 @@ impl<L: Lane<Scalar = f32>> Visitor for Batch<'_, L> {
         self.hits(h, false);
     }
 
+    #[inline(never)]
     fn focal_plane(self, _: Kernel) {
         let num =
             L::from_f32_fn(|i| FocalPlane::new(self.get(i).origin(), &self.get(i).plane()).num());
@@ -664,12 +670,14 @@ impl<L: Lane<Scalar = f32>> Visitor for Batch<'_, L> {
         self.hits(h, false);
     }
 
+    #[inline(never)]
     fn triangle<K: TriangleKernel>(self, _: Kernel) {
         let tris = TrianglePacket::<L>::from_fn(|i| self.get(i).triangle());
         let h = K::intersect(&self.ray, &K::prepare(&self.ray), &tris, Cull::None).normalized();
         self.hits(h, true);
     }
 
+    #[inline(never)]
     fn focal_triangle(self, _: Kernel) {
         // A per-case cache with the eye at the ray origin.
         let mut e = [FocalTriangle::never(); MAX_LANES];

@@ -265,6 +265,10 @@ fn closest_spheres<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, s: &[Sphere]) 
 
 /// [`Mesh::try_closest`] with [`Watertight`], out of line.
 #[inline(never)]
-fn closest_triangles<L: Lane>(mesh: &Mesh, rays: &RayPacket<L>, cull: Cull) -> Option<hit::Best<L>> {
+fn closest_triangles<L: Lane>(
+    mesh: &Mesh,
+    rays: &RayPacket<L>,
+    cull: Cull,
+) -> Option<hit::Best<L>> {
     mesh.try_closest::<Watertight, L>(rays, cull)
 }

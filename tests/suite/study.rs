@@ -80,9 +80,8 @@ pub fn report() -> String {
                 .unwrap_or_else(|| panic!("{}: cannot be evaluated", c.file));
             *slot = Some((errors.t, errors.wrong));
         }
-        m.watertight = watertight::Method::ALL
-            .into_iter()
-            .find(|w| kind == Kind::Triangle && w.name() == e.method)
+        m.watertight = watertight::methods()
+            .find(|w| kind == Kind::Triangle && w.method().name() == e.method)
             .map(|w| {
                 let t = watertight::totals(w);
                 (t.rays, t.leaks, t.doubles)
