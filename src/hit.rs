@@ -127,10 +127,6 @@ pub struct Best<L: Lane> {
     pub(crate) w: L,
 }
 
-/// The former name of [`Best`].
-#[doc(hidden)]
-pub type Hit<L> = Best<L>;
-
 /// One hit of one ray, as the scalar API reports it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HitRecord {

@@ -82,7 +82,7 @@ pub use camera::Pinhole;
 pub use hit::{HitRecord, LaneHit};
 pub use lane::{Lane, Mask};
 pub use query::{Hit, Hits, Query, Rays, Using};
-pub use ray::{Ray, Ray4, Ray8, Ray16, RayPacket};
+pub use ray::{Dir, Ray, Ray4, Ray8, Ray16, RayPacket};
 pub use vec3::V3;
 
 /// The vector library of the API (`raylane::glam::Vec3`): no need to pin its version.

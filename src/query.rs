@@ -415,10 +415,36 @@ pub fn sphere_hit<L: Lane>(roots: &Roots<L>, cull: Cull) -> LaneHit<L> {
     }
 }
 
+/// Reports the roots of sphere `index` to an `all` query: the entry roots, then (unless culled)
+/// the exit roots, each as records when some lane has one.
+pub(crate) fn each_root<L: Lane>(
+    rays: &RayPacket<L>,
+    roots: &Roots<L>,
+    cull: Cull,
+    index: u32,
+    sphere: &dyn Fn(u32) -> Option<Sphere>,
+    f: &mut dyn FnMut(&Hits<L>),
+) {
+    let zero = L::from_f32(0.0);
+    let entry = LaneHit::new(roots.t0, zero, zero, roots.m0);
+    let exit = LaneHit::new(roots.t1, L::from_f32(1.0), zero, roots.m1);
+    let sides: &[LaneHit<L>] = if cull.back() {
+        &[entry]
+    } else {
+        &[entry, exit]
+    };
+    for h in sides {
+        if h.mask.any() {
+            let best = Best::single(h, index);
+            f(&Hits::from_spheres(rays, &best, sphere));
+        }
+    }
+}
+
 /// Rays a kernel can answer: for the unit-direction kernels, lanes whose `|d|²` is more than
 /// [`UNIT_TOLERANCE`] from 1 get the empty interval (a miss); others unchanged.
 #[inline(always)]
-fn admit<L: Lane>(rays: &RayPacket<L>, unit_directions: bool) -> RayPacket<L> {
+pub(crate) fn admit<L: Lane>(rays: &RayPacket<L>, unit_directions: bool) -> RayPacket<L> {
     if !unit_directions {
         return *rays;
     }
@@ -427,6 +453,28 @@ fn admit<L: Lane>(rays: &RayPacket<L>, unit_directions: bool) -> RayPacket<L> {
     RayPacket {
         t_min: L::select(ok, rays.t_min, L::from_f32(f32::INFINITY)),
         t_max: L::select(ok, rays.t_max, L::from_f32(f32::NEG_INFINITY)),
+        ..*rays
+    }
+}
+
+/// Caller storage too small for a result: `needed` entries are required (e.g.
+/// [`Mesh::focus`](crate::mesh::Mesh::focus); nothing was written).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct TooSmall {
+    /// The number of entries the storage must hold.
+    pub needed: usize,
+}
+
+/// The rays of a focal cache's query: lanes whose origin is not exactly `eye` get the empty
+/// interval (a documented miss; 3 cmp per query).
+#[inline(always)]
+pub(crate) fn at_eye<L: Lane>(rays: &RayPacket<L>, eye: Vec3) -> RayPacket<L> {
+    let e = V3::<L>::splat(eye);
+    let o = rays.origin;
+    let same = o.x.ge(e.x) & o.x.le(e.x) & o.y.ge(e.y) & o.y.le(e.y) & o.z.ge(e.z) & o.z.le(e.z);
+    RayPacket {
+        t_min: L::select(same, rays.t_min, L::from_f32(f32::INFINITY)),
+        t_max: L::select(same, rays.t_max, L::from_f32(f32::NEG_INFINITY)),
         ..*rays
     }
 }
@@ -641,22 +689,9 @@ impl<K: SphereKernel> Query for Using<'_, [Sphere], K> {
 
     fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
         let r = admit(rays, K::UNIT_DIRECTIONS);
-        let zero = L::from_f32(0.0);
         for (i, s) in self.set.iter().enumerate() {
             let roots = K::roots(&r, &SpherePacket::splat(s));
-            let entry = LaneHit::new(roots.t0, zero, zero, roots.m0);
-            let exit = LaneHit::new(roots.t1, L::from_f32(1.0), zero, roots.m1);
-            let sides: &[LaneHit<L>] = if self.cull.back() {
-                &[entry]
-            } else {
-                &[entry, exit]
-            };
-            for h in sides {
-                if h.mask.any() {
-                    let best = Best::single(h, i as u32);
-                    f(&Hits::from_spheres(&r, &best, |_| Some(*s)));
-                }
-            }
+            each_root(&r, &roots, self.cull, i as u32, &|_| Some(*s), f);
         }
     }
 }

@@ -32,6 +32,14 @@ impl Ray {
         Self::with_interval(origin, dir, 0.0, f32::INFINITY)
     }
 
+    /// A ray over `(0, +inf)` with a unit direction (`t` is then a distance): the rays the
+    /// unit-direction kernels answer.
+    #[inline]
+    #[must_use]
+    pub fn unit(origin: Vec3, dir: Dir) -> Self {
+        Self::new(origin, dir.0)
+    }
+
     /// A ray over `(t_min, t_max)`. Bad input (see the [module docs](self)) gives a ray that
     /// never hits.
     #[inline]
@@ -95,6 +103,57 @@ impl Ray {
     #[must_use]
     pub fn with_t_max(self, t_max: f32) -> Self {
         Self::with_interval(self.origin, self.dir, self.t_min, t_max)
+    }
+}
+
+/// A unit direction: what the unit-direction kernels ([`Geometric`](crate::sphere::Geometric),
+/// [`QuadraticUnit`](crate::sphere::QuadraticUnit), the sphere focal caches) need. Made by
+/// [`Dir::new`], whose `v/|v|` (correctly rounded `sqrt` and divisions) is checked to satisfy
+/// `||d|² − 1| ≤ 2^-20`; use it with [`Ray::unit`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Dir(Vec3);
+
+impl Dir {
+    /// +x.
+    pub const X: Dir = Dir(Vec3::X);
+    /// +y.
+    pub const Y: Dir = Dir(Vec3::Y);
+    /// +z.
+    pub const Z: Dir = Dir(Vec3::Z);
+    /// −x.
+    pub const NEG_X: Dir = Dir(Vec3::NEG_X);
+    /// −y.
+    pub const NEG_Y: Dir = Dir(Vec3::NEG_Y);
+    /// −z.
+    pub const NEG_Z: Dir = Dir(Vec3::NEG_Z);
+
+    /// `v/|v|`, or `None` for a zero or non-finite `v`. `v` is first divided by its largest
+    /// `|component|` so that no square over- or underflows (at most 3 div, 3 mul, 2 add,
+    /// 1 sqrt, 3 div).
+    #[must_use]
+    pub fn new(v: Vec3) -> Option<Dir> {
+        let m = v.abs().max_element();
+        if !(v.is_finite() && m > 0.0) {
+            return None;
+        }
+        let w = V3::<f32>::from(v / m);
+        let d = w.div_by(crate::lane::sqrt_f32(w.length_squared()));
+        let ok = (d.length_squared() - 1.0).abs() <= crate::query::UNIT_TOLERANCE;
+        ok.then_some(Dir(d.into()))
+    }
+
+    /// The vector.
+    #[inline]
+    #[must_use]
+    pub fn get(self) -> Vec3 {
+        self.0
+    }
+}
+
+impl From<Dir> for Vec3 {
+    #[inline]
+    fn from(d: Dir) -> Vec3 {
+        d.0
     }
 }
 

@@ -15,7 +15,7 @@
 use std::hint::black_box;
 
 use glam::Vec3;
-use raylane::hit::Hit;
+use raylane::hit::Best;
 use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
 use raylane::sphere::focal::{self as sf, FocalKernel};
 use raylane::sphere::{self, FocalSphere, Sphere, SphereKernel, SpherePacket};
@@ -373,7 +373,7 @@ impl Shape {
 /// One frame of closest-hit queries of ray packets; returns the number of lanes hit. Out of
 /// line, one copy per kernel and width (the closure is inlined into it).
 #[inline(never)]
-pub fn packets_frame<L: Lane, F: Fn(&RayPacket<L>) -> Hit<L>>(
+pub fn packets_frame<L: Lane, F: Fn(&RayPacket<L>) -> Best<L>>(
     packets: &[RayPacket<L>],
     f: F,
 ) -> u32 {
@@ -408,7 +408,7 @@ pub trait WithKernel<L: Lane> {
     /// Runs with the kernel's queries.
     fn run(
         self,
-        packets: impl Fn(&RayPacket<L>) -> Hit<L>,
+        packets: impl Fn(&RayPacket<L>) -> Best<L>,
         soa: impl Fn(&Ray) -> Option<HitRecord>,
     ) -> Self::Output;
 }
@@ -497,7 +497,7 @@ pub fn run<L: Lane<Scalar = f32>>(k: Kernel, shape: Shape, frame: &Frame, lanes:
         type Output = u32;
         fn run(
             self,
-            p: impl Fn(&RayPacket<L>) -> Hit<L>,
+            p: impl Fn(&RayPacket<L>) -> Best<L>,
             s: impl Fn(&Ray) -> Option<HitRecord>,
         ) -> u32 {
             match self.0 {
@@ -521,7 +521,7 @@ pub fn answers<L: Lane<Scalar = f32>>(
         type Output = Vec<Option<HitRecord>>;
         fn run(
             self,
-            p: impl Fn(&RayPacket<L>) -> Hit<L>,
+            p: impl Fn(&RayPacket<L>) -> Best<L>,
             s: impl Fn(&Ray) -> Option<HitRecord>,
         ) -> Self::Output {
             match self.0 {
@@ -554,7 +554,7 @@ pub fn frame_ops(k: Kernel, frame: &Frame, used: usize) -> raylane::opcount::OpC
         type Output = ();
         fn run(
             self,
-            p: impl Fn(&RayPacket<Counted<f32>>) -> Hit<Counted<f32>>,
+            p: impl Fn(&RayPacket<Counted<f32>>) -> Best<Counted<f32>>,
             _: impl Fn(&Ray) -> Option<HitRecord>,
         ) {
             for r in &self.0.packets {

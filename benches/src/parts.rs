@@ -11,10 +11,9 @@
 use std::hint::black_box;
 
 use glam::Vec3;
-use raylane::hit::Hit;
 use raylane::mesh::{FocalMesh, Mesh};
-use raylane::triangle::{Cull, FocalRays, FocalTriangle, Triangle};
-use raylane::{Lane, Mask, RayPacket};
+use raylane::triangle::{FocalTriangle, Triangle};
+use raylane::{Hits, Lane, Mask, Query, RayPacket};
 
 /// Triangles in parts, each part its own vertex and index arrays (unshared vertices).
 pub struct Parts {
@@ -91,7 +90,10 @@ impl Parts {
             .iter()
             .zip(&self.indices)
             .zip(storage.iter_mut())
-            .map(|((p, i), out)| Mesh::bounded(p, i).focus(eye, out))
+            .map(|((p, i), out)| {
+                let mesh = Mesh::bounded(p, i);
+                mesh.focus(eye, out).expect("storage() sizes every cache")
+            })
             .collect()
     }
 }
@@ -127,19 +129,11 @@ fn split(
 
 /// The closest hit of one packet of rays from the meshes' eye over every part.
 #[inline(always)]
-fn closest<L: Lane>(rays: &RayPacket<L>, meshes: &[FocalMesh]) -> Hit<L> {
-    let fr = FocalRays::new(rays);
-    let mut best = Hit::<L>::none();
+fn closest<L: Lane>(rays: &RayPacket<L>, meshes: &[FocalMesh]) -> Hits<L> {
+    let mut best = Hits::<L>::none();
     for m in meshes {
-        // The bounding sphere first (`FocalMesh::may_hit`), then the triangles.
-        let h = m.closest(&fr, Cull::None);
-        let take = h.mask & h.t.lt(best.t);
-        if take.any() {
-            best.t = L::select(take, h.t, best.t);
-            best.u = L::select(take, h.u, best.u);
-            best.v = L::select(take, h.v, best.v);
-            best.mask = best.mask | take;
-        }
+        // The bounding sphere first, then the triangles; ties keep the earlier part.
+        best.merge(&m.closest(rays));
     }
     best
 }

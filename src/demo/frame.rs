@@ -199,7 +199,10 @@ fn pieces<'a>(
                     .split_at_mut_checked(n)
                     .ok_or(SetupError::TriangleStorage)?;
                 store = rest;
-                Some(mesh.focus(e, head))
+                Some(
+                    mesh.focus(e, head)
+                        .map_err(|_| SetupError::TriangleStorage)?,
+                )
             }
             None => None,
         };

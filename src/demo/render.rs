@@ -2,7 +2,7 @@
 
 use super::empty_sphere;
 use super::{Camera, Frame, ID_NONE, ID_PLANE, ID_SPHERE, ID_TRIANGLE, Stats, Tile};
-use crate::hit::Hit;
+use crate::hit;
 use crate::lane::{Lane, MAX_LANES, Mask};
 use crate::mesh::Mesh;
 use crate::plane;
@@ -33,7 +33,7 @@ impl Best {
     }
 
     /// Takes the lanes of `h` that are strictly closer.
-    fn merge<L: Lane<Scalar = f32>>(&mut self, h: &Hit<L>, id: u8, part: u8) {
+    fn merge<L: Lane<Scalar = f32>>(&mut self, h: &hit::Best<L>, id: u8, part: u8) {
         let mut bits = h.mask.bits();
         while bits != 0 {
             let i = bits.trailing_zeros() as usize;
@@ -153,7 +153,7 @@ impl Frame<'_> {
 
     /// The closest sphere hit with the frame's kernel.
     #[inline(never)]
-    fn spheres<L: Lane<Scalar = f32>>(&self, rays: &RayPacket<L>) -> Hit<L> {
+    fn spheres<L: Lane<Scalar = f32>>(&self, rays: &RayPacket<L>) -> hit::Best<L> {
         self.kernel.visit(SphereHits { frame: self, rays })
     }
 
@@ -191,8 +191,8 @@ impl Frame<'_> {
         &self,
         rays: &RayPacket<L>,
         guarded: bool,
-    ) -> Hit<L> {
-        let mut best = Hit::<L>::none();
+    ) -> hit::Best<L> {
+        let mut best = hit::Best::<L>::none();
         crate::lane::assert_fits::<L>();
         let mut entries = [empty_sphere(); MAX_LANES];
         for (j, s) in self.scene.spheres.iter().enumerate() {
@@ -229,13 +229,13 @@ struct SphereHits<'f, 'a, L: Lane> {
 }
 
 impl<L: Lane<Scalar = f32>> Visitor for SphereHits<'_, '_, L> {
-    type Output = Hit<L>;
+    type Output = hit::Best<L>;
 
-    fn sphere<K: SphereKernel>(self, _: Kernel) -> Hit<L> {
+    fn sphere<K: SphereKernel>(self, _: Kernel) -> hit::Best<L> {
         closest_spheres::<K, L>(self.rays, self.frame.scene.spheres)
     }
 
-    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) -> Hit<L> {
+    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) -> hit::Best<L> {
         match self.frame.camera {
             Camera::Pinhole(_) => sf::closest::<K, L>(self.rays, self.frame.spheres),
             Camera::Ortho(_) => self.frame.focal_per_ray::<K, L>(self.rays, guarded),
@@ -243,28 +243,32 @@ impl<L: Lane<Scalar = f32>> Visitor for SphereHits<'_, '_, L> {
     }
 
     // Not sphere kernels: `Frame::new` refuses them.
-    fn plane(self, _: Kernel) -> Hit<L> {
-        Hit::none()
+    fn plane(self, _: Kernel) -> hit::Best<L> {
+        hit::Best::none()
     }
-    fn focal_plane(self, _: Kernel) -> Hit<L> {
-        Hit::none()
+    fn focal_plane(self, _: Kernel) -> hit::Best<L> {
+        hit::Best::none()
     }
-    fn triangle<K: TriangleKernel>(self, _: Kernel) -> Hit<L> {
-        Hit::none()
+    fn triangle<K: TriangleKernel>(self, _: Kernel) -> hit::Best<L> {
+        hit::Best::none()
     }
-    fn focal_triangle(self, _: Kernel) -> Hit<L> {
-        Hit::none()
+    fn focal_triangle(self, _: Kernel) -> hit::Best<L> {
+        hit::Best::none()
     }
 }
 
 /// [`sphere::closest`] out of line.
 #[inline(never)]
-fn closest_spheres<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, s: &[Sphere]) -> Hit<L> {
+fn closest_spheres<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, s: &[Sphere]) -> hit::Best<L> {
     sphere::closest::<K, L>(rays, s)
 }
 
 /// [`Mesh::try_closest`] with [`Watertight`], out of line.
 #[inline(never)]
-fn closest_triangles<L: Lane>(mesh: &Mesh, rays: &RayPacket<L>, cull: Cull) -> Option<Hit<L>> {
+fn closest_triangles<L: Lane>(
+    mesh: &Mesh,
+    rays: &RayPacket<L>,
+    cull: Cull,
+) -> Option<hit::Best<L>> {
     mesh.try_closest::<Watertight, L>(rays, cull)
 }

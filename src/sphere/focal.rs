@@ -55,7 +55,9 @@ use glam::Vec3;
 use super::{Roots, Sphere, SpherePacket};
 use crate::hit::{self, HitRecord};
 use crate::lane::{Lane, Mask};
+use crate::query::{self, Hits, Query, TooSmall, sphere_hit};
 use crate::ray::{Ray, RayPacket};
+use crate::triangle::Cull;
 use crate::vec3::V3;
 
 /// Unit roundoff of f32.
@@ -516,7 +518,7 @@ fn hit_path<L: Lane, S: FocalLanes<L>>(
 pub fn closest<K: FocalKernel, L: Lane>(
     rays: &RayPacket<L>,
     cache: &[FocalSphere<f32>],
-) -> hit::Hit<L> {
+) -> hit::Best<L> {
     hit::closest_filtered(
         rays,
         cache,
@@ -567,4 +569,120 @@ pub fn closest_soa<K: FocalKernel, L: Lane>(
 #[must_use]
 pub fn any_soa<K: FocalKernel, L: Lane>(ray: &Ray, cache: &[FocalSphere<L>]) -> bool {
     hit::any_soa(ray, cache, |r, e| K::maybe_roots(r, e).map(|r| r.first()))
+}
+
+/// A guarded sphere cache that owns its eye (see the [module docs](self)): through [`Query`]
+/// it answers rays that start exactly at the eye and have unit directions
+/// (`||d|² − 1| ≤ 2^-20`, as [`Ray::unit`](crate::Ray::unit) makes them); any other ray is a
+/// miss, never wrong roots.
+#[derive(Clone, Copy, Debug)]
+pub struct FocalSpheres<'c> {
+    eye: Vec3,
+    cache: &'c [FocalSphere<f32>],
+    cull: Cull,
+}
+
+impl<'c> FocalSpheres<'c> {
+    /// The number of entries [`focus`](Self::focus) needs for `spheres`: one per sphere.
+    #[inline]
+    #[must_use]
+    pub fn needed(spheres: &[Sphere]) -> usize {
+        spheres.len()
+    }
+
+    /// Builds the guarded entries of `spheres` for rays from `eye` into `out` (entry `i` for
+    /// sphere `i`); `out` shorter than [`needed`](Self::needed) is an error (nothing built).
+    pub fn focus(
+        eye: Vec3,
+        spheres: &[Sphere],
+        out: &'c mut [FocalSphere<f32>],
+    ) -> Result<Self, TooSmall> {
+        let needed = Self::needed(spheres);
+        let Some(out) = out.get_mut(..needed) else {
+            return Err(TooSmall { needed });
+        };
+        focus(eye, spheres, out);
+        Ok(FocalSpheres {
+            eye,
+            cache: out,
+            cull: Cull::None,
+        })
+    }
+
+    /// The eye.
+    #[inline]
+    #[must_use]
+    pub fn eye(&self) -> Vec3 {
+        self.eye
+    }
+
+    /// The entries.
+    #[inline]
+    #[must_use]
+    pub fn cache(&self) -> &'c [FocalSphere<f32>] {
+        self.cache
+    }
+
+    /// The same cache with [`Query`] calls culled ([`Cull::Back`]: entry roots only).
+    #[inline]
+    #[must_use]
+    pub fn culled(self, cull: Cull) -> Self {
+        FocalSpheres { cull, ..self }
+    }
+
+    /// The rays this cache answers (see the type's docs).
+    #[inline(always)]
+    fn admitted<L: Lane>(&self, rays: &RayPacket<L>) -> RayPacket<L> {
+        query::admit(&query::at_eye(rays, self.eye), true)
+    }
+
+    /// Sphere `i`, for the records.
+    fn sphere(&self, i: u32) -> Option<Sphere> {
+        let e = self.cache.get(i as usize)?;
+        Some(Sphere::new(e.center.into(), e.radius))
+    }
+}
+
+/// Guarded focal spheres ([`Focal`]): two passes per block (the cheap test first), in index
+/// order; `all` reports, per sphere in index order, its entry roots, then its exit roots.
+impl Query for FocalSpheres<'_> {
+    #[inline]
+    fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
+        let r = self.admitted(rays);
+        let cull = self.cull;
+        let best = hit::closest_filtered(
+            &r,
+            self.cache,
+            |r, e| Focal::candidate(r, &Splat(e)),
+            |r, e| Focal::maybe_roots(r, &Splat(e)).map(|x| sphere_hit(&x, cull)),
+        );
+        Hits::from_spheres(&r, &best, |i| self.sphere(i))
+    }
+
+    #[inline]
+    fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
+        let r = self.admitted(rays);
+        let cull = self.cull;
+        hit::any_filtered(
+            &r,
+            self.cache,
+            |r, e| Focal::candidate(r, &Splat(e)),
+            |r, e| Focal::maybe_roots(r, &Splat(e)).map(|x| sphere_hit(&x, cull)),
+        )
+    }
+
+    fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
+        let r = self.admitted(rays);
+        for (i, e) in self.cache.iter().enumerate() {
+            let roots = Focal::roots(&r, &Splat(e));
+            query::each_root(
+                &r,
+                &roots,
+                self.cull,
+                i as u32,
+                &|_| self.sphere(i as u32),
+                f,
+            );
+        }
+    }
 }

@@ -476,7 +476,7 @@ pub fn intersect<K: SphereKernel>(ray: &Ray, sphere: &Sphere) -> Option<HitRecor
 /// Closest hit of ray lanes over a slice of spheres with kernel `K` (N rays × 1 sphere).
 #[inline]
 #[must_use]
-pub fn closest<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) -> hit::Hit<L> {
+pub fn closest<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) -> hit::Best<L> {
     hit::closest(rays, spheres, |r, s| {
         Some(K::roots(r, &SpherePacket::splat(s)).first())
     })

@@ -112,7 +112,7 @@ use glam::Vec3;
 
 use super::exact;
 use super::{Cull, Triangle, in_front, within};
-use crate::hit::{self, Hit, HitRecord, LaneHit};
+use crate::hit::{self, Best, HitRecord, LaneHit};
 use crate::lane::{Lane, Mask, Scalar};
 use crate::ray::{Ray, RayPacket};
 use crate::vec3::V3;
@@ -289,6 +289,27 @@ impl FocalTriangle<f32> {
             b: b.into(),
             c: c.into(),
             e: eye.into(),
+        }
+    }
+}
+
+impl FocalTriangle<f32> {
+    /// The eye the entry was built for (`None` for an entry that is never hit).
+    #[inline]
+    #[must_use]
+    pub fn eye(&self) -> Option<Vec3> {
+        let e: Vec3 = self.e.into();
+        e.is_finite().then_some(e)
+    }
+
+    /// The triangle (one that is never hit for such an entry).
+    #[inline]
+    #[must_use]
+    pub fn triangle(&self) -> Triangle {
+        Triangle {
+            a: self.a.into(),
+            b: self.b.into(),
+            c: self.c.into(),
         }
     }
 }
@@ -795,7 +816,7 @@ pub fn closest_prepared<L: Lane>(
     rays: &FocalRays<L>,
     cache: &[FocalTriangle<f32>],
     cull: Cull,
-) -> Hit<L> {
+) -> Best<L> {
     // Two passes, the cheap edge test over a block of triangles first.
     let mut best = hit::closest_filtered(
         &rays.scaled,
@@ -810,7 +831,7 @@ pub fn closest_prepared<L: Lane>(
 /// Closest hit of ray packets from the cache's eye over cached triangles (N rays × 1).
 #[inline]
 #[must_use]
-pub fn closest<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull: Cull) -> Hit<L> {
+pub fn closest<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull: Cull) -> Best<L> {
     closest_prepared(&FocalRays::new(rays), cache, cull)
 }
 

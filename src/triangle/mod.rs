@@ -98,7 +98,7 @@ pub use watertight::{Shear, Watertight};
 
 use glam::Vec3;
 
-use crate::hit::{self, Hit, HitRecord, LaneHit};
+use crate::hit::{self, Best, HitRecord, LaneHit};
 use crate::lane::{Lane, Mask};
 use crate::ray::{Ray, RayPacket};
 use crate::vec3::V3;
@@ -143,6 +143,13 @@ impl Triangle {
         } else {
             Self::never()
         }
+    }
+
+    /// A triangle already known to be valid (finite, nonzero area): no check.
+    #[inline(always)]
+    #[must_use]
+    pub(crate) fn valid(a: Vec3, b: Vec3, c: Vec3) -> Self {
+        Triangle { a, b, c }
     }
 
     /// A triangle that is never hit (NaN vertices).
@@ -389,7 +396,7 @@ pub fn closest<K: TriangleKernel, L: Lane>(
     rays: &RayPacket<L>,
     tris: &[Triangle],
     cull: Cull,
-) -> Hit<L> {
+) -> Best<L> {
     let pre = K::prepare(rays);
     hit::closest(rays, tris, |r, t| {
         Some(K::intersect(r, &pre, &TrianglePacket::splat(t), cull))

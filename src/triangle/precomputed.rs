@@ -1,7 +1,7 @@
 //! Triangle tests that run on data computed once per triangle.
 
 use super::{Cull, Triangle, TrianglePacket};
-use crate::hit::Hit;
+use crate::hit::Best;
 use crate::hit::LaneHit;
 use crate::lane::Lane;
 use crate::ray::RayPacket;
@@ -109,6 +109,6 @@ pub fn closest_precomputed<K: PrecomputedKernel, L: Lane>(
     rays: &RayPacket<L>,
     records: &[K::Prim<L>],
     cull: Cull,
-) -> Hit<L> {
+) -> Best<L> {
     crate::hit::closest(rays, records, |r, p| Some(K::test(r, p, cull)))
 }

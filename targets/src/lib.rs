@@ -12,18 +12,17 @@
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use glam::Vec3;
-use raylane::hit::Hit;
+use raylane::hit::Best;
 use raylane::mesh::Mesh;
 use raylane::plane::{self, FocalPlane, Plane};
 use raylane::registry::{Kernel, Visitor};
 use raylane::sphere::focal::{self as sf, Focal, FocalKernel};
 use raylane::sphere::{self, FocalSphere, Robust, Sphere, SphereKernel, SpherePacket};
 use raylane::triangle::{
-    self, Cull, FocalRays, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket,
-    Watertight,
+    self, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket, Watertight,
 };
 use raylane::vectors::{Case, Kind, Values};
-use raylane::{Lane, Mask, Ray, RayPacket};
+use raylane::{Lane, Mask, Query, Ray, RayPacket};
 
 // The critical-section implementations the semihosting crates need (single core / hart).
 #[cfg(target_arch = "arm")]
@@ -147,8 +146,12 @@ fn sink(bits: u32) {
     unsafe { write_volatile(addr_of_mut!(SINK), read_volatile(addr_of!(SINK)) ^ bits) }
 }
 
-fn hits<L: Lane<Scalar = f32>>(h: &Hit<L>) {
+fn hits<L: Lane<Scalar = f32>>(h: &Best<L>) {
     sink(h.mask.bits() ^ h.t.lane(0).to_bits() ^ h.u.lane(0).to_bits());
+}
+
+fn query_hits<L: Lane<Scalar = f32>>(h: &raylane::Hits<L>) {
+    sink(h.mask.bits() ^ h.t.lane(0).to_bits() ^ h.normal.x.lane(0).to_bits());
 }
 
 fn rec(r: Option<raylane::HitRecord>) {
@@ -249,9 +252,10 @@ pub fn every_kernel<L: Lane<Scalar = f32>>(rays: &RayPacket<L>, ray: &Ray) {
     let positions = [v(0), v(3), v(6), v(9)];
     let indices = [[0u32, 1, 2], [1, 3, 2], [0, 3, 9]];
     let mesh = Mesh::bounded(&positions, &indices);
-    hits(&mesh.closest::<Watertight, L>(rays, Cull::None));
-    sink(mesh.any::<Moller, L>(rays, Cull::None).bits());
+    query_hits(&mesh.closest(rays));
+    sink(mesh.using::<Moller>().any(rays).bits());
     let mut mcache = [FocalTriangle::never(); 3];
-    let fm = mesh.focus(eye, &mut mcache);
-    hits(&fm.closest(&FocalRays::new(rays), Cull::None));
+    if let Ok(fm) = mesh.focus(eye, &mut mcache) {
+        query_hits(&fm.closest(rays));
+    }
 }

@@ -26,11 +26,13 @@ use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::mesh::Mesh;
 use raylane::triangle::{self, Triangle, focal};
-use raylane::triangle::{Cull, FocalRays, FocalTriangle, Moller, TriangleKernel, Watertight};
+use raylane::triangle::{Cull, FocalTriangle, Moller, TriangleKernel, Watertight};
 use raylane::{HitRecord, Lane, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
 use crate::exact_ref::exact;
+use crate::query::record;
+use raylane::Query;
 
 /// Positions and index triples.
 pub struct Model {
@@ -293,8 +295,10 @@ fn focal_packets<L: Lane<Scalar = f32>>(
 ) -> Vec<Option<HitRecord>> {
     rays.chunks(L::LANES)
         .flat_map(|c| {
-            let h = fm.closest(&FocalRays::new(&RayPacket::<L>::from_rays(c)), Cull::None);
-            (0..c.len()).map(move |i| h.lane(i)).collect::<Vec<_>>()
+            let h = fm.closest(&RayPacket::<L>::from_rays(c));
+            (0..c.len())
+                .map(move |i| record(h.lane(i)))
+                .collect::<Vec<_>>()
         })
         .collect()
 }
@@ -413,7 +417,7 @@ fn one_eye(
                 Ray::new(eye, target - eye)
             })
             .collect();
-        let fm = mesh.focus(eye, cache);
+        let fm = mesh.focus(eye, cache).unwrap();
         let f = focal_packets::<f32x8>(&fm, &rays);
         if all_shapes {
             let others = [
@@ -485,17 +489,10 @@ fn bunny_69k_visible_surface() {
     );
     let mesh = Mesh::new(&m.pos, &m.idx);
     let mut cache = vec![FocalTriangle::never(); m.idx.len()];
-    let fm = mesh.focus(eye, &mut cache);
+    let fm = mesh.focus(eye, &mut cache).unwrap();
     let ray = Ray::new(eye, dir);
-    let h = fm
-        .closest(
-            &FocalRays::new(&RayPacket::<f32x8>::splat(&ray)),
-            Cull::None,
-        )
-        .lane(0);
-    let w = mesh
-        .closest::<Watertight, f32>(&RayPacket::splat(&ray), Cull::None)
-        .get();
+    let h = record(fm.closest(&RayPacket::<f32x8>::splat(&ray)).lane(0));
+    let w = record(mesh.closest(&ray));
     let show = |h: Option<HitRecord>| {
         h.map(|h| {
             let [a, b, c] = m.idx[h.index as usize].map(|q| m.pos[q as usize]);

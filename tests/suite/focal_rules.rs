@@ -6,10 +6,9 @@ use glam::Vec3;
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
 use raylane::triangle::{
-    self, Cramer, Cull, FocalRays, FocalTriangle, Moller, Triangle, TriangleKernel, Watertight,
-    focal,
+    self, Cramer, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, Watertight, focal,
 };
-use raylane::{HitRecord, Ray, RayPacket};
+use raylane::{HitRecord, Query, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
 /// Every focal entry point on one ray over `tris` from the ray's origin: the scalar record
@@ -83,15 +82,15 @@ fn focal_all_entry_points(ray: &Ray, tris: &[Triangle], cull: Cull) -> Option<Hi
         Mesh::bounded(&positions, &indices),
     ] {
         let mut out = vec![FocalTriangle::never(); tris.len()];
-        let fm = mesh.focus(eye, &mut out);
-        let fr = FocalRays::new(&RayPacket::<f32x8>::splat(ray));
-        let h = fm.closest(&fr, cull);
+        let fm = mesh.focus(eye, &mut out).unwrap().culled(cull);
+        let fr = RayPacket::<f32x8>::splat(ray);
+        let h = fm.closest(&fr);
         for i in 0..8 {
-            same(h.lane(i), "FocalMesh::closest");
+            same(crate::query::record(h.lane(i)), "FocalMesh::closest");
         }
-        assert_eq!(fm.any(&fr, cull).all(), want.is_some(), "FocalMesh::any");
+        assert_eq!(fm.any(&fr).all(), want.is_some(), "FocalMesh::any");
         let mut n = 0;
-        fm.all(&fr, cull, |_, h| n += h.mask.any() as usize);
+        fm.all(&fr, |h: raylane::Hits<f32x8>| n += h.mask.any() as usize);
         assert_eq!(n > 0, want.is_some(), "FocalMesh::all");
     }
     if let Some(h) = want {

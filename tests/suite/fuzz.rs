@@ -21,11 +21,12 @@
 //! host, 300 on AArch64, whose CI run is under qemu-user); the seed is fixed (`RAYLANE_FUZZ_SEED`
 //! changes it), so a failure names its case and replays.
 
+use crate::query::record;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
-use raylane::hit::{Hit, HitRecord};
+use raylane::hit::{Best, HitRecord};
 use raylane::mesh::Mesh;
 use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
 use raylane::sphere::focal::{self as sf, Focal, FocalKernel, FocalUnguarded};
@@ -35,10 +36,9 @@ use raylane::sphere::{
 };
 use raylane::triangle::focal as tf;
 use raylane::triangle::{
-    self, Cramer, Cull, FocalRays, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket,
-    Watertight,
+    self, Cramer, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket, Watertight,
 };
-use raylane::{Lane, Mask, Pinhole, Ray, RayPacket};
+use raylane::{Hits, Lane, Mask, Pinhole, Query, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
 /// Focal triangle hits are checked to be finite and strictly inside their interval (issue 10,
@@ -525,7 +525,7 @@ fn planes<L: Lane<Scalar = f32>>(c: &Case) {
 fn hits_agree<L: Lane<Scalar = f32>>(
     what: &str,
     rays: &[Ray],
-    h: &Hit<L>,
+    h: &Best<L>,
     one: impl Fn(&Ray) -> Option<HitRecord>,
 ) {
     for (i, ray) in rays.iter().enumerate() {
@@ -643,38 +643,44 @@ fn meshes<K: TriangleKernel, L: Lane<Scalar = f32>>(c: &Case, cull: Cull) {
         let s = b.sphere();
         assert!(s.is_valid(), "ritter: invalid sphere {s:?}");
     }
+    let plain_q = plain.using::<K>().culled(cull);
     for (m, exact) in [(plain, true), (ritter, true), (odd, false)] {
-        let h = m.closest::<K, L>(&packet, cull);
-        let any = m.any::<K, L>(&packet, cull);
-        let one = |ray: &Ray| m.closest::<K, f32>(&RayPacket::splat(ray), cull).get();
-        hits_agree(name, rays, &h, one);
+        let q = m.using::<K>().culled(cull);
+        let h = q.closest(&packet);
+        let any = q.any(&packet);
+        let one = |ray: &Ray| record(q.closest(ray));
+        query_hits_agree(name, rays, &h, one);
         for (i, ray) in rays.iter().enumerate() {
             let o = one(ray);
             if let Some(r) = o {
                 record_ok(name, ray, &r, true);
             }
             same(name, any.test(i), o.is_some());
-            same(name, bits(m.closest_soa::<K, L>(ray, cull)), bits(o));
-            same(name, m.any_soa::<K, L>(ray, cull), o.is_some());
+            same(name, q.any(ray), o.is_some());
             if exact {
                 // The Ritter bound contains every vertex: culling never loses a hit.
-                let p = plain.closest::<K, f32>(&RayPacket::splat(ray), cull).get();
+                let p = record(plain_q.closest(ray));
                 assert_eq!(bits(o), bits(p), "ritter culling: {ray:?}, {:?}", m.bound());
             }
         }
-        m.all::<K, L>(&packet, cull, |_, h| {
+        q.all(&packet, |h: Hits<L>| {
             for (i, ray) in rays.iter().enumerate() {
-                if h.mask.test(i) {
-                    let r = HitRecord {
-                        t: h.t.lane(i),
-                        u: h.u.lane(i),
-                        v: h.v.lane(i),
-                        index: 0,
-                    };
+                if let Some(r) = record(h.lane(i)) {
                     record_ok(name, ray, &r, true);
                 }
             }
         });
+    }
+}
+
+fn query_hits_agree<L: Lane<Scalar = f32>>(
+    what: &str,
+    rays: &[Ray],
+    h: &Hits<L>,
+    one: impl Fn(&Ray) -> Option<HitRecord>,
+) {
+    for (i, ray) in rays.iter().enumerate() {
+        same(what, bits(record(h.lane(i))), bits(one(ray)));
     }
 }
 
@@ -684,19 +690,15 @@ fn focal_meshes<L: Lane<Scalar = f32>>(c: &Case, cull: Cull) {
     let packet = RayPacket::<L>::from_rays(rays);
     let plain = Mesh::new(&c.positions, &c.indices);
     let invalid = plain.with_bound(&Sphere::new(Vec3::ZERO, -1.0));
-    let mut base = vec![FocalTriangle::never(); c.indices.len()];
-    let unbounded = plain.focus(c.eye, &mut base);
+    let mut base = vec![FocalTriangle::never(); plain.needed()];
+    let unbounded = plain.focus(c.eye, &mut base).unwrap().culled(cull);
     for m in [plain, Mesh::bounded(&c.positions, &c.indices), invalid] {
-        let mut cache = vec![FocalTriangle::never(); c.indices.len()];
-        let fm = m.focus(c.eye, &mut cache);
-        let fr = FocalRays::new(&packet);
-        let h = fm.closest(&fr, cull);
-        let any = fm.any(&fr, cull);
-        let one = |ray: &Ray| {
-            fm.closest(&FocalRays::new(&RayPacket::<f32>::splat(ray)), cull)
-                .get()
-        };
-        hits_agree("focal mesh", rays, &h, one);
+        let mut cache = vec![FocalTriangle::never(); m.needed()];
+        let fm = m.focus(c.eye, &mut cache).unwrap().culled(cull);
+        let h = Query::closest(&fm, &packet);
+        let any = Query::any(&fm, &packet);
+        let one = |ray: &Ray| record(Query::closest(&fm, ray));
+        query_hits_agree("focal mesh", rays, &h, one);
         for (i, ray) in rays.iter().enumerate() {
             let o = one(ray);
             if let Some(r) = o {
@@ -704,20 +706,12 @@ fn focal_meshes<L: Lane<Scalar = f32>>(c: &Case, cull: Cull) {
             }
             same("focal mesh any", any.test(i), o.is_some());
             // A bound (valid or not) never loses a hit of the unbounded cache.
-            let u = unbounded
-                .closest(&FocalRays::new(&RayPacket::<f32>::splat(ray)), cull)
-                .get();
+            let u = record(Query::closest(&unbounded, ray));
             same("focal mesh culling", bits(o), bits(u));
         }
-        fm.all(&fr, cull, |_, h| {
+        Query::all(&fm, &packet, |h: Hits<L>| {
             for (i, ray) in rays.iter().enumerate() {
-                if h.mask.test(i) {
-                    let r = HitRecord {
-                        t: h.t.lane(i),
-                        u: h.u.lane(i),
-                        v: h.v.lane(i),
-                        index: 0,
-                    };
+                if let Some(r) = record(h.lane(i)) {
                     record_ok("focal mesh all", ray, &r, check);
                 }
             }

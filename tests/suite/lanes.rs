@@ -4,7 +4,7 @@
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
-use raylane::hit::Hit;
+use raylane::hit::Best;
 use raylane::lane::{Lane, Mask};
 use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
 use raylane::registry::{Kernel, Prim, Visitor};
@@ -249,7 +249,7 @@ fn focal_fallback_lanes_equal_scalar() {
     far_rim::<f32x16>(3);
 }
 
-fn same_hit<L: Lane<Scalar = f32>>(h: &Hit<L>, i: usize, s: &Hit<f32>) {
+fn same_hit<L: Lane<Scalar = f32>>(h: &Best<L>, i: usize, s: &Best<f32>) {
     assert_eq!(h.lane(i), s.get());
     if let Some(r) = h.lane(i) {
         assert_eq!(r.t.to_bits(), s.t.to_bits());

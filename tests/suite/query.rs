@@ -47,6 +47,17 @@ fn ray(rng: &mut SmallRng, c: Vec3, scale: f32) -> Ray {
     }
 }
 
+/// A query's record as the kernels' record (`t`, `u`, `v`, index), for the tests that compare
+/// with the kernels' own entry points.
+pub fn record(h: Option<Hit>) -> Option<raylane::HitRecord> {
+    h.map(|h| raylane::HitRecord {
+        t: h.t,
+        u: h.u,
+        v: h.v,
+        index: h.index,
+    })
+}
+
 fn bits(h: Option<Hit>) -> Option<[u32; 12]> {
     h.map(|h| {
         [
@@ -262,4 +273,134 @@ fn plane_and_scene_queries_every_lane_equals_one_ray() {
     for k in 0..3 {
         assert!(sets.contains(&k), "no hit of set {k}");
     }
+}
+
+#[test]
+fn mesh_and_focal_mesh_queries_every_lane_equals_one_ray() {
+    use raylane::mesh::Mesh;
+    use raylane::query::TooSmall;
+    use raylane::triangle::FocalTriangle;
+    let m = load_bin(include_bytes!("../data/bunny.bin"));
+    // Two invalid triangles (an index out of range, a zero-area one): listed once, never hit.
+    let mut idx = m.idx.clone();
+    idx.push([0, 0, 1]);
+    idx.push([0, 1, u32::MAX]);
+    let tris: Vec<Triangle> = idx
+        .iter()
+        .map(|t| {
+            let p = |k: u32| m.pos.get(k as usize).copied();
+            match (p(t[0]), p(t[1]), p(t[2])) {
+                (Some(a), Some(b), Some(c)) => Triangle::new(a, b, c),
+                _ => Triangle::never(),
+            }
+        })
+        .collect();
+    let mesh = Mesh::new(&m.pos, &idx);
+    assert_eq!(mesh.invalid(), 2);
+    let bounded = Mesh::bounded(&m.pos, &idx);
+    let (lo, hi) = m
+        .pos
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
+            (l.min(*p), h.max(*p))
+        });
+    let (c, size) = ((lo + hi) / 2.0, (hi - lo).length() / 2.0);
+    let mut rng = SmallRng::seed_from_u64(14);
+    let rays: Vec<Ray> = (0..120).map(|_| ray(&mut rng, c, size)).collect();
+    let want = every_width(&tris[..], &rays, "triangles");
+    for (q, what) in [(mesh, "mesh"), (bounded, "bounded mesh")] {
+        let got = every_width(&q, &rays, what);
+        assert_eq!(
+            got.iter().map(|h| bits(*h)).collect::<Vec<_>>(),
+            want.iter().map(|h| bits(*h)).collect::<Vec<_>>(),
+            "{what} vs the same triangles"
+        );
+    }
+    // Focal: rays from the eye; rays from elsewhere are a miss.
+    let eye = c + Vec3::new(0.2, 0.3, 2.0) * size;
+    let mut cache = vec![FocalTriangle::never(); mesh.needed()];
+    assert_eq!(
+        mesh.focus(eye, &mut cache[..10]).err(),
+        Some(TooSmall { needed: idx.len() })
+    );
+    let fm = bounded.focus(eye, &mut cache).unwrap();
+    let from_eye: Vec<Ray> = (0..160)
+        .map(|_| Ray::new(eye, (c + vec(&mut rng, 0.6 * size) - eye).normalize()))
+        .collect();
+    let hits = every_width(&fm, &from_eye, "focal mesh");
+    assert!(hits.iter().flatten().count() > 40);
+    for (r, h) in from_eye.iter().zip(&hits) {
+        // The same surface as Watertight, nearly the same t (different kernels).
+        let w = tris.closest(r);
+        assert_eq!(h.map(|h| h.index), w.map(|w| w.index), "{r:?}");
+        let elsewhere = Ray::new(r.origin() + Vec3::X * 1e-3, r.dir());
+        assert_eq!(Query::closest(&fm, &elsewhere), None);
+        assert!(!Query::any(&fm, &elsewhere));
+    }
+    let culled = every_width(&fm.culled(Cull::Back), &from_eye, "culled focal mesh");
+    assert!(culled.iter().flatten().all(|h| h.front));
+}
+
+#[test]
+fn focal_spheres_and_planes_own_their_eye() {
+    use raylane::Dir;
+    use raylane::plane::{FocalPlane, FocalPlanes};
+    use raylane::query::TooSmall;
+    use raylane::sphere::FocalSphere;
+    use raylane::sphere::focal::FocalSpheres;
+    let mut rng = SmallRng::seed_from_u64(15);
+    let s = spheres(&mut rng, 20);
+    let planes: Vec<Plane> = (0..4)
+        .map(|_| Plane::new(vec(&mut rng, 8.0), vec(&mut rng, 2.0)))
+        .collect();
+    let eye = Vec3::new(1.0, 2.0, 12.0);
+    let mut sc = vec![FocalSphere::pass_all(); FocalSpheres::needed(&s)];
+    assert_eq!(
+        FocalSpheres::focus(eye, &s, &mut sc[..3]).err(),
+        Some(TooSmall { needed: 20 })
+    );
+    let fs = FocalSpheres::focus(eye, &s, &mut sc).unwrap();
+    let mut pc = vec![FocalPlane::new(eye, &planes[0]); FocalPlanes::needed(&planes)];
+    let fp = FocalPlanes::focus(eye, &planes, &mut pc).unwrap();
+    let rays: Vec<Ray> = (0..160)
+        .map(|_| match Dir::new(vec(&mut rng, 8.0) - eye) {
+            Some(d) => Ray::unit(eye, d),
+            None => Ray::new(eye, Vec3::ZERO),
+        })
+        .collect();
+    let hits = every_width(&fs, &rays, "focal spheres");
+    assert!(hits.iter().flatten().count() > 20);
+    for (r, h) in rays.iter().zip(&hits) {
+        // The same sphere and face as Robust, t within the focal kernel's 2^-16.
+        let w = s.closest(r);
+        assert_eq!(
+            h.map(|h| (h.index, h.front)),
+            w.map(|w| (w.index, w.front)),
+            "{r:?}"
+        );
+        if let (Some(h), Some(w)) = (h, w) {
+            assert!((h.t - w.t).abs() <= w.t * 1.0 / 65536.0);
+        }
+        // Not from the eye, or not unit length: a miss.
+        let moved = Ray::new(r.origin() + Vec3::Y, r.dir());
+        let long = Ray::new(r.origin(), r.dir() * 1.5);
+        assert_eq!((fs.closest(&moved), fs.closest(&long)), (None, None));
+        assert!(!fs.any(&moved) && !fs.any(&long));
+    }
+    every_width(&fs.culled(Cull::Back), &rays, "culled focal spheres");
+    let ph = every_width(&fp, &rays, "focal planes");
+    for (r, h) in rays.iter().zip(&ph) {
+        assert_eq!(
+            bits(*h),
+            bits(planes.closest(r)),
+            "focal planes vs planes: {r:?}"
+        );
+        assert_eq!(fp.closest(&Ray::new(r.origin() + Vec3::X, r.dir())), None);
+    }
+    assert_eq!(Dir::new(Vec3::ZERO), None);
+    assert_eq!(
+        Dir::new(Vec3::new(0.0, 3e38, 3e38)).unwrap().get().y,
+        core::f32::consts::FRAC_1_SQRT_2
+    );
+    assert!(Dir::new(Vec3::new(1e-40, 0.0, 0.0)).unwrap().get() == Vec3::X);
 }

@@ -12,7 +12,7 @@ use raylane::sphere::{
     self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Roots, Sphere, SphereKernel,
     SpherePacket,
 };
-use raylane::triangle::{Cull, FocalRays, FocalTriangle, Watertight};
+use raylane::triangle::FocalTriangle;
 use raylane::{Lane, Pinhole, Ray, RayPacket, V3};
 
 /// `v` as an exact `f64` vector.
@@ -92,18 +92,16 @@ fn invalid_bound_culls_nothing_in_mesh_and_focal_mesh() {
     let bounded = Mesh::bounded(&pos, &idx);
     let bad = Mesh::new(&pos, &idx).with_bound(&Sphere::new(Vec3::ZERO, -1.0));
     for mesh in [bounded, bad] {
-        let h = mesh.closest::<Watertight, f32>(&RayPacket::splat(&ray), Cull::None);
-        assert_eq!(h.get().map(|h| h.t), Some(5.0));
+        let h = raylane::Query::closest(&mesh, &ray);
+        assert_eq!(h.map(|h| h.t), Some(5.0));
         let mut cache = [FocalTriangle::never(); 2];
-        let fm = mesh.focus(Vec3::ZERO, &mut cache);
-        let rays = FocalRays::new(&RayPacket::<f32x8>::splat(&ray));
-        let fh = fm.closest(&rays, Cull::None);
+        let fm = mesh.focus(Vec3::ZERO, &mut cache).unwrap();
+        let fh = raylane::Query::closest(&fm, &RayPacket::<f32x8>::splat(&ray));
         for i in 0..8 {
             assert_eq!(fh.lane(i).map(|h| h.t), Some(5.0), "focal mesh, lane {i}");
         }
-        let one = FocalRays::new(&RayPacket::<f32>::splat(&ray));
-        assert_eq!(fm.closest(&one, Cull::None).get().map(|h| h.t), Some(5.0));
-        assert!(fm.any(&one, Cull::None));
+        assert_eq!(raylane::Query::closest(&fm, &ray).map(|h| h.t), Some(5.0));
+        assert!(raylane::Query::any(&fm, &ray));
     }
     // The focal form of an invalid bound passes every ray, and is itself never hit.
     let e = Bound::new(&Sphere::new(Vec3::ZERO, -1.0)).focal(Vec3::ZERO);

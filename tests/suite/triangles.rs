@@ -4,12 +4,13 @@
 //! and bounding spheres are measured (tightness against the exact minimal sphere, hits never
 //! lost to culling, triangle tests saved).
 
+use crate::query::record;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
 use raylane::demo::shapes;
-use raylane::hit::Hit;
+use raylane::hit::Best;
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
 use raylane::opcount::{OpCounts, table};
@@ -21,7 +22,7 @@ use raylane::triangle::{
     self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout, Moller,
     Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
 };
-use raylane::{HitRecord, LaneHit, Ray, RayPacket};
+use raylane::{HitRecord, Hits, LaneHit, Query, Ray, RayPacket};
 use std::marker::PhantomData;
 use wide::{f32x4, f32x8, f32x16};
 
@@ -259,7 +260,7 @@ fn fallback_lanes<L: Lane<Scalar = f32>>(seed: u64) {
             .collect();
         let rp = RayPacket::<L>::from_rays(&rays);
         let mut cache = vec![FocalTriangle::never(); idx.len()];
-        let fm = mesh.focus(eye, &mut cache);
+        let fm = mesh.focus(eye, &mut cache).unwrap();
         let fr = FocalRays::new(&rp);
         for i in 0..idx.len() {
             let t = mesh.triangle(i).unwrap();
@@ -295,7 +296,7 @@ fn exact_fallback_lanes_equal_scalar() {
     fallback_lanes::<f32x16>(3);
 }
 
-fn same_hit<L: Lane<Scalar = f32>>(h: &Hit<L>, i: usize, s: &Hit<f32>, what: &str) {
+fn same_hit<L: Lane<Scalar = f32>>(h: &Best<L>, i: usize, s: &Best<f32>, what: &str) {
     assert_eq!(h.lane(i), s.get(), "{what}: lane {i}");
     if let Some(r) = h.lane(i) {
         assert_eq!(r.t.to_bits(), s.t.to_bits(), "{what}: t bits lane {i}");
@@ -305,6 +306,14 @@ fn same_hit<L: Lane<Scalar = f32>>(h: &Hit<L>, i: usize, s: &Hit<f32>, what: &st
 
 /// All hits as sorted `(lane, index, t bits)` triples.
 type AllHits = Vec<(usize, u32, u32)>;
+
+fn collect_hits<L: Lane<Scalar = f32>>(out: &mut AllHits, h: &Hits<L>) {
+    for lane in 0..L::LANES {
+        if let Some(x) = h.lane(lane) {
+            out.push((lane, x.index, x.t.to_bits()));
+        }
+    }
+}
 
 fn collect<L: Lane<Scalar = f32>>(out: &mut AllHits, i: u32, h: &LaneHit<L>) {
     for lane in 0..L::LANES {
@@ -325,8 +334,9 @@ fn entry_points_of<K: TriangleKernel, L: Lane<Scalar = f32>>(
     let any = triangle::any::<K, L>(&rp, tris, cull);
     let mut soa = vec![TrianglePacket::<L>::from_triangles(&[]); tris.len().div_ceil(L::LANES)];
     TrianglePacket::pack(tris, &mut soa);
-    let m_closest = mesh.closest::<K, L>(&rp, cull);
-    let m_any = mesh.any::<K, L>(&rp, cull);
+    let mq = mesh.using::<K>().culled(cull);
+    let m_closest = mq.closest(&rp);
+    let m_any = mq.any(&rp);
     for (i, r) in rays.iter().enumerate() {
         let s = RayPacket::<f32>::splat(r);
         let single = triangle::closest::<K, f32>(&s, tris, cull);
@@ -337,22 +347,19 @@ fn entry_points_of<K: TriangleKernel, L: Lane<Scalar = f32>>(
         if tris.len() == 1 {
             assert_eq!(triangle::intersect::<K>(r, &tris[0], cull), single.get());
         }
-        let m_single = mesh.closest::<K, f32>(&s, cull);
-        same_hit(&m_closest, i, &m_single, "mesh closest");
-        assert_eq!(m_any.test(i), m_single.mask, "mesh any");
-        assert_eq!(
-            mesh.closest_soa::<K, L>(r, cull),
-            m_single.get(),
-            "mesh soa"
-        );
-        assert_eq!(mesh.any_soa::<K, L>(r, cull), m_single.mask, "mesh any soa");
+        let m_single = mq.closest(r);
+        assert_eq!(m_closest.lane(i), m_single, "mesh closest, lane {i}");
+        if tris.len() == mesh.len() {
+            assert_eq!(record(m_single), single.get(), "mesh = its triangles");
+        }
+        assert_eq!(m_any.test(i), m_single.is_some(), "mesh any");
     }
     // All hits: the same per lane as the scalar path, for the slice and the mesh.
     for use_mesh in [false, true] {
         let mut seen = AllHits::new();
         let mut want = AllHits::new();
         if use_mesh {
-            mesh.all::<K, L>(&rp, cull, |i, h| collect(&mut seen, i, h));
+            mq.all(&rp, |h: Hits<L>| collect_hits(&mut seen, &h));
         } else {
             triangle::all::<K, L>(&rp, tris, cull, |i, h| collect(&mut seen, i, h));
         }
@@ -360,7 +367,9 @@ fn entry_points_of<K: TriangleKernel, L: Lane<Scalar = f32>>(
             let s = RayPacket::<f32>::splat(r);
             let mut add = |i: u32, h: &LaneHit<f32>| want.push((lane, i, h.t.to_bits()));
             if use_mesh {
-                mesh.all::<K, f32>(&s, cull, &mut add);
+                mq.all(r, |h: raylane::Hit| {
+                    add(h.index, &LaneHit::new(h.t, h.u, h.v, true))
+                });
             } else {
                 triangle::all::<K, f32>(&s, tris, cull, &mut add);
             }
@@ -410,10 +419,9 @@ fn focal_entry_points<L: Lane<Scalar = f32>>(
     let closest = tf::closest::<L>(&rp, &cache, cull);
     let any = tf::any::<L>(&rp, &cache, cull);
     let mut mcache = vec![FocalTriangle::never(); mesh.len()];
-    let fm = mesh.focus(eye, &mut mcache);
-    let fr = FocalRays::new(&rp);
-    let m_closest = fm.closest(&fr, cull);
-    let m_any = fm.any(&fr, cull);
+    let fm = mesh.focus(eye, &mut mcache).unwrap().culled(cull);
+    let m_closest = fm.closest(&rp);
+    let m_any = fm.any(&rp);
     for (i, r) in rays.iter().enumerate() {
         let s = RayPacket::<f32>::splat(r);
         let single = tf::closest::<f32>(&s, &cache, cull);
@@ -429,15 +437,12 @@ fn focal_entry_points<L: Lane<Scalar = f32>>(
             single.mask,
             "focal any soa"
         );
-        let fs = FocalRays::new(&s);
-        let m_single = fm.closest(&fs, cull);
-        same_hit(&m_closest, i, &m_single, "focal mesh closest");
-        assert_eq!(m_any.test(i), m_single.mask, "focal mesh any");
+        let m_single = fm.closest(r);
+        assert_eq!(m_closest.lane(i), m_single, "focal mesh closest, lane {i}");
+        assert_eq!(record(m_single), single.get(), "focal mesh = its entries");
+        assert_eq!(m_any.test(i), m_single.is_some(), "focal mesh any");
         // The focal kernel finds what the watertight kernel finds, up to edge ties.
-        if let (Some(a), Some(b)) = (
-            m_single.get(),
-            mesh.closest::<Watertight, f32>(&s, cull).get(),
-        ) {
+        if let (Some(a), Some(b)) = (m_single, mesh.using::<Watertight>().culled(cull).closest(r)) {
             assert!(
                 (a.t - b.t).abs() <= 1e-4 * a.t.abs().max(1.0),
                 "focal {a:?} vs watertight {b:?}"
@@ -445,14 +450,12 @@ fn focal_entry_points<L: Lane<Scalar = f32>>(
         }
     }
     let mut seen = AllHits::new();
-    fm.all(&fr, cull, |i, h| collect(&mut seen, i, h));
+    fm.all(&rp, |h: Hits<L>| collect_hits(&mut seen, &h));
     let mut want = AllHits::new();
     for (lane, r) in rays.iter().enumerate() {
-        fm.all(
-            &FocalRays::new(&RayPacket::<f32>::splat(r)),
-            cull,
-            |i, h| want.push((lane, i, h.t.to_bits())),
-        );
+        fm.all(r, |h: raylane::Hit| {
+            want.push((lane, h.index, h.t.to_bits()))
+        });
     }
     seen.sort_unstable();
     want.sort_unstable();
@@ -577,15 +580,12 @@ fn bad_input_is_a_miss() {
     let mesh = Mesh::bounded(&pos, &idx);
     assert!(mesh.triangle(0).is_none() && !mesh.triangle(1).unwrap().is_valid());
     let r = RayPacket::<f32x8>::splat(&down);
-    assert!(
-        mesh.closest::<Watertight, f32x8>(&r, Cull::None)
-            .mask
-            .none()
-    );
+    assert!(mesh.closest(&r).mask.none());
     let mut cache = [FocalTriangle::never(); 3];
     assert!(
         mesh.focus(down.origin(), &mut cache)
-            .closest(&FocalRays::new(&r), Cull::None)
+            .unwrap()
+            .closest(&r)
             .mask
             .none()
     );
@@ -888,16 +888,13 @@ fn culling_never_loses_a_hit_and_saves_tests() {
                 tested += tris_per_mesh;
             }
             fn check<K: TriangleKernel>(b: &Mesh, p: &Mesh, rp: &RayPacket<f32>) -> Option<f32> {
-                let (x, y) = (
-                    b.closest::<K, f32>(rp, Cull::None),
-                    p.closest::<K, f32>(rp, Cull::None),
-                );
-                assert_eq!(x.get(), y.get(), "{}: culling lost a hit", K::NAME);
+                let (x, y) = (b.using::<K>().closest(rp), p.using::<K>().closest(rp));
+                assert_eq!(x.lane(0), y.lane(0), "{}: culling lost a hit", K::NAME);
                 let (mut hx, mut hy) = (Vec::new(), Vec::new());
-                b.all::<K, f32>(rp, Cull::None, |i, h| hx.push((i, h.t.to_bits())));
-                p.all::<K, f32>(rp, Cull::None, |i, h| hy.push((i, h.t.to_bits())));
+                b.using::<K>().all(rp, |h: Hits<f32>| hx.push(h.lane(0)));
+                p.using::<K>().all(rp, |h: Hits<f32>| hy.push(h.lane(0)));
                 assert_eq!(hx, hy, "{}: culling lost a hit", K::NAME);
-                y.get().map(|h| h.t)
+                y.lane(0).map(|h| h.t)
             }
             check::<Cramer>(b, p, &rp);
             check::<Moller>(b, p, &rp);
@@ -912,14 +909,14 @@ fn culling_never_loses_a_hit_and_saves_tests() {
     let fms: Vec<_> = bounded
         .iter()
         .zip(caches.iter_mut())
-        .map(|(b, c)| b.focus(eye, c))
+        .map(|(b, c)| b.focus(eye, c).unwrap())
         .collect();
     let mut pcaches: Vec<Vec<FocalTriangle<f32>>> =
         vec![vec![FocalTriangle::never(); tris_per_mesh]; plain.len()];
     let fps: Vec<_> = plain
         .iter()
         .zip(pcaches.iter_mut())
-        .map(|(p, c)| p.focus(eye, c))
+        .map(|(p, c)| p.focus(eye, c).unwrap())
         .collect();
     for r in &focal_rays {
         let fr = FocalRays::new(&RayPacket::<f32>::splat(r));
@@ -927,9 +924,9 @@ fn culling_never_loses_a_hit_and_saves_tests() {
             if b.may_hit(&fr) {
                 focal_tested += tris_per_mesh;
             }
-            let (x, y) = (b.closest(&fr, Cull::None), p.closest(&fr, Cull::None));
-            assert_eq!(x.get(), y.get(), "focal: culling lost a hit");
-            focal_hits += y.get().is_some() as usize;
+            let (x, y) = (b.closest(r), p.closest(r));
+            assert_eq!(x, y, "focal: culling lost a hit");
+            focal_hits += y.is_some() as usize;
         }
     }
     let all = rays.len() * bounded.len() * tris_per_mesh;

@@ -20,7 +20,7 @@ use raylane::mesh::Mesh;
 use raylane::registry::{Kernel, Prim, Visitor};
 use raylane::sphere::SphereKernel;
 use raylane::sphere::focal::FocalKernel;
-use raylane::triangle::{Cull, FocalRays, FocalTriangle, TriangleKernel};
+use raylane::triangle::{FocalTriangle, TriangleKernel};
 use raylane::{Ray, RayPacket};
 
 pub(crate) struct Shape {
@@ -277,9 +277,9 @@ fn hits(m: Method, s: &Shape, ray: &Ray, cache: &mut [FocalTriangle<f32>]) -> Ve
     let mesh = Mesh::new(&s.pos, &s.idx);
     let rp = RayPacket::<f32>::splat(ray);
     let mut out = Vec::new();
-    let push = |i: u32, h: &raylane::LaneHit<f32>| {
+    let push = |h: raylane::Hit| {
         assert!(h.t.is_finite() && h.u.is_finite() && h.v.is_finite());
-        out.push((h.t, i));
+        out.push((h.t, h.index));
     };
     struct All<'a, F> {
         mesh: &'a Mesh<'a>,
@@ -288,14 +288,16 @@ fn hits(m: Method, s: &Shape, ray: &Ray, cache: &mut [FocalTriangle<f32>]) -> Ve
         cache: &'a mut [FocalTriangle<f32>],
         push: F,
     }
-    impl<F: FnMut(u32, &raylane::LaneHit<f32>)> Visitor for All<'_, F> {
+    impl<F: FnMut(raylane::Hit)> Visitor for All<'_, F> {
         type Output = ();
         fn triangle<K: TriangleKernel>(self, _: Kernel) {
-            self.mesh.all::<K, f32>(self.rp, Cull::None, self.push);
+            let ray = self.rp.ray(0);
+            raylane::Query::all(&raylane::Using::<_, K>::new(self.mesh), &ray, self.push);
         }
         fn focal_triangle(self, _: Kernel) {
-            let fm = self.mesh.focus(self.eye, self.cache);
-            fm.all(&FocalRays::new(self.rp), Cull::None, self.push);
+            if let Ok(fm) = self.mesh.focus(self.eye, self.cache) {
+                raylane::Query::all(&fm, &self.rp.ray(0), self.push);
+            }
         }
         fn sphere<K: SphereKernel>(self, k: Kernel) {
             unreachable!("{} is not a triangle kernel", k.name())

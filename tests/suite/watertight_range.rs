@@ -5,10 +5,10 @@
 //! overflows): those sizes are measured and printed, not pinned.
 
 use glam::Vec3;
+use raylane::Ray;
 use raylane::demo::shapes;
 use raylane::mesh::Mesh;
-use raylane::triangle::{Cramer, Cull, Moller, TriangleKernel, Watertight};
-use raylane::{Ray, RayPacket};
+use raylane::triangle::{Cramer, Moller, TriangleKernel, Watertight};
 
 /// The demo's icosphere of frequency 3 about an off-axis centre, radius 2, vertices snapped to
 /// multiples of 2^-12 (shared vertices stay shared: the mesh is still closed).
@@ -60,7 +60,7 @@ fn leaks<K: TriangleKernel>(k: i32) -> (usize, usize) {
     for (ray, crossings) in &cases {
         let r = Ray::new(ray.origin() * s, ray.dir());
         let mut ts = Vec::new();
-        m.all::<K, f32>(&RayPacket::splat(&r), Cull::None, |_, h| {
+        raylane::Query::all(&raylane::Using::<_, K>::new(&m), &r, |h: raylane::Hit| {
             assert!(h.t.is_finite() && h.u.is_finite() && h.v.is_finite());
             ts.push(h.t)
         });

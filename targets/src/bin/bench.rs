@@ -15,7 +15,7 @@
 
 use core::hint::black_box;
 
-use raylane::hit::Hit;
+use raylane::hit::Best;
 use raylane::plane::{self, FocalPlane, Plane};
 use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
 use raylane::sphere::{self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
@@ -62,7 +62,7 @@ pub extern "C" fn bench_end() {
 
 /// One frame of closest-hit queries, one ray at a time; returns the rays hit.
 #[inline(never)]
-fn frame<F: Fn(&RayPacket<f32>) -> Hit<f32>>(rays: &[Ray], f: F) -> u32 {
+fn frame<F: Fn(&RayPacket<f32>) -> Best<f32>>(rays: &[Ray], f: F) -> u32 {
     let mut n = 0;
     for r in rays {
         let h = f(black_box(&RayPacket::splat(r)));
