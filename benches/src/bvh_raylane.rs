@@ -20,7 +20,6 @@ use glam::Vec3;
 use raylane::bvh::{self, Bvh, Leaf, Node, Primitives, Scratch, Sphere4, Tri4};
 use raylane::mesh::{FocalMesh, Mesh};
 use raylane::sphere::{self, Robust, Sphere};
-use raylane::triangle::{Cull, Watertight};
 use raylane::{Lane, Mask, Query, Ray, RayPacket};
 
 use crate::meshes::Answers;
@@ -57,7 +56,7 @@ pub fn closest<L: Lane<Scalar = f32>>(
         let mut best = [None; 16];
         let mut mask = L::Mask::splat(false);
         for (k, m) in meshes.iter().enumerate() {
-            let h = m.closest::<Watertight, L>(&r, Cull::None);
+            let h = m.closest_packet(&r);
             if h.mask.any() {
                 r = r.shrink(h.mask, h.t);
                 mask = mask | h.mask;
@@ -96,7 +95,7 @@ pub fn any<L: Lane<Scalar = f32>>(
         let live = r.valid();
         let mut occ = L::Mask::splat(false);
         for m in meshes {
-            let h = m.any::<Watertight, L>(&r, Cull::None);
+            let h = m.any_packet(&r);
             if h.any() {
                 occ = occ | h;
                 if (occ | !live).all() {
