@@ -145,6 +145,14 @@ impl Triangle {
         }
     }
 
+    /// Vertices exactly as [`Triangle::new`] stored them (NaN for a triangle that is never
+    /// hit), without its checks: for copies of valid triangles (the BVH's leaves).
+    #[inline]
+    #[must_use]
+    pub(crate) const fn stored(a: Vec3, b: Vec3, c: Vec3) -> Self {
+        Triangle { a, b, c }
+    }
+
     /// A triangle that is never hit (NaN vertices).
     #[must_use]
     pub const fn never() -> Self {
