@@ -8,7 +8,12 @@
 //! cargo run --example opcount            # the two Markdown tables (the README's)
 //! cargo run --example opcount -- --csv   # the report as kernel,path,mul,add,div,sqrt,cmp
 //! cargo run --example opcount -- --write # rewrites the README's study table (from the root)
+//! opcount --measure                       # the study's timed loops (scripts/count-study.sh)
 //! ```
+//!
+//! The study table's instruction columns are not measured here: `scripts/count-study.sh` counts
+//! them (callgrind on x86-64-v3, the QEMU plugin on a Cortex-M4F) and stores them in
+//! `docs/study-insns.txt`, which this example reads.
 
 // The study table's accuracy and watertightness come from the test suite's own harnesses,
 // included here so that the example and the pin test measure with the same code.
@@ -20,7 +25,43 @@ mod watertight;
 #[path = "../tests/suite/study.rs"]
 mod study;
 
+/// Every study method on both paths (and its precomputation, if any), each one out-of-line
+/// call of `raylane::study::repeat` over 64 iterations and one over none, in 8 lanes, each
+/// call announced by a `cfg SHAPE METHOD PATH UNITS N` line (`UNITS` tests or builds per
+/// iteration; under callgrind, dump k is call k).
+fn measure() {
+    use raylane::study::{self, METHODS, PATHS, Path, Shape};
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    for (i, (shape, method)) in METHODS.iter().enumerate() {
+        let shape = match shape {
+            Shape::Triangle => "triangle",
+            Shape::Sphere => "sphere",
+        };
+        for (path, name) in PATHS {
+            if path == Path::Precompute && !study::precomputes(i) {
+                continue;
+            }
+            let units = study::units::<wide::f32x8>(i, path);
+            for n in [64, 0] {
+                writeln!(out, "cfg {shape} {method} {name} {units} {n}").expect("stdout");
+                out.flush().expect("stdout");
+                let done = study::repeat::<wide::f32x8>(
+                    std::hint::black_box(i),
+                    std::hint::black_box(path),
+                    std::hint::black_box(n),
+                );
+                let miss = path == Path::Miss;
+                assert_eq!(done, Some(if miss { 0 } else { (units * n) as u32 }));
+            }
+        }
+    }
+}
+
 fn main() {
+    if std::env::args().any(|a| a == "--measure") {
+        return measure();
+    }
     let csv = std::env::args().any(|a| a == "--csv");
     let write = std::env::args().any(|a| a == "--write");
     let mut out = String::new();

@@ -37,10 +37,11 @@ use std::time::{Duration, Instant};
 use glam::Vec3;
 use raylane::Lane;
 use raylane::demo::{
-    self, Frame, Method, Part, Scene, Stats, Storage, Tile,
+    self, Frame, Part, Scene, Stats, Storage, Tile,
     scenes::{self, Ground, Mix, Precision},
 };
 use raylane::plane::FocalPlane;
+use raylane::registry::Kernel;
 use raylane::sphere::FocalSphere;
 use raylane::triangle::FocalTriangle;
 use wide::{f32x4, f32x8, f32x16};
@@ -553,7 +554,7 @@ fn mesh(o: &Options) -> (&'static str, Picture, usize) {
     let frame = Frame::new(
         scene,
         scenes::icosphere_camera(w, h),
-        Method::Focal,
+        Kernel::Focal,
         st.storage(),
     )
     .expect("storage sized for the scene");
@@ -572,7 +573,7 @@ fn mix(o: &Options) -> (&'static str, Picture, usize) {
     let (w, h) = o.size.unwrap_or((800, 600));
     let m = Mix::new();
     let mut st = Store::for_scene(&m.scene());
-    let frame = Frame::new(m.scene(), Mix::camera(w, h), Method::Focal, st.storage())
+    let frame = Frame::new(m.scene(), Mix::camera(w, h), Kernel::Focal, st.storage())
         .expect("storage sized for the scene");
     let cells = [Panel {
         frame,

@@ -30,8 +30,9 @@
 //!   `ρ`, for any `μ > 0`; both `μ = 2^-10` and `μ = 2^-4` are tested and a lane is rejected
 //!   when either rejects it. A NaN anywhere accepts (the compares are `!(|l|² > …)`).
 //!
-//! Cost per ray and mesh: 17 mul, 16 add, 1 div, 4 cmp ([`Bound::may_hit`]); with a focal
-//! cache ([`Bound::focal`]) the [`FocalSphere`] test: 4 mul, 2 add, 1 cmp on a miss.
+//! Cost per ray and mesh ([`Bound::may_hit`]):
+//! `ops bound/per mesh: 17 mul, 16 add, 1 div, 4 cmp`; with a focal cache ([`Bound::focal`])
+//! the [`FocalSphere`] test: 4 mul, 2 add, 1 cmp on a miss.
 //!
 //! **Limits.** The bound is a test only for directions with `d·d` within `2^-100…2^100`
 //! (`|d|` within `2^-50…2^50`), where `d·d` neither underflows nor overflows; rays outside

@@ -31,9 +31,11 @@
 //! [`lane`] (the abstraction), [`vec3`] (`V3<L>`, SoA vectors), [`ray`] (rays and packets),
 //! [`camera`] (pinhole primary rays from one focal point), [`sphere`], [`plane`], [`triangle`],
 //! [`mesh`] (triangles over shared vertex slices), [`bounds`] (bounding spheres and culling),
-//! [`hit`] (records and the closest/any loops), [`opcount`] (the counting lane), and, behind the
-//! `vectors` feature, [`vectors`] (the test-vector parser, runner and digest shared by the
-//! checker, the tests and the firmware).
+//! [`hit`] (records and the closest/any loops), [`registry`] (the one list of kernels that the
+//! checker, the demo, the benchmarks, the firmware and the op-count report walk), [`opcount`]
+//! (the counting lane), and, behind the `vectors` feature, `vectors` (the test-vector parser,
+//! runner and digest shared by the checker, the tests and the firmware) and behind the `demo`
+//! feature `demo` (the scenes and their renderer). `ARCHITECTURE.md` draws the layers.
 //!
 //! ## Example
 //!
@@ -63,6 +65,7 @@ pub mod opcount;
 pub mod plane;
 pub mod query;
 pub mod ray;
+pub mod registry;
 pub mod sphere;
 pub mod study;
 pub mod triangle;

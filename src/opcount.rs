@@ -305,9 +305,61 @@ pub struct Row {
     pub counts: OpCounts,
 }
 
-/// The report: every kernel on a miss and on a hit, measured with `Counted<f32>` on the
-/// lectures' worked examples (sphere centre (5,5,5), radius 3; the miss ray from the origin
-/// along (1,3,4)/√26, the hit ray from (1,0,1) along (1,2,1)/√6).
+/// Most rows the report holds.
+pub const MAX_ROWS: usize = 96;
+
+/// The report's rows: see [`table`]. Derefs to `[Row]`.
+#[derive(Clone, Copy, Debug)]
+pub struct Table {
+    rows: [Row; MAX_ROWS],
+    len: usize,
+}
+
+impl Table {
+    fn new() -> Self {
+        let empty = Row {
+            kernel: "",
+            path: "",
+            counts: OpCounts::default(),
+        };
+        Table {
+            rows: [empty; MAX_ROWS],
+            len: 0,
+        }
+    }
+
+    /// Adds a row (dropped past [`MAX_ROWS`]; a test checks the report fits).
+    fn push(&mut self, kernel: &'static str, path: &'static str, counts: OpCounts) {
+        if let Some(slot) = self.rows.get_mut(self.len) {
+            *slot = Row {
+                kernel,
+                path,
+                counts,
+            };
+            self.len += 1;
+        }
+    }
+}
+
+impl core::ops::Deref for Table {
+    type Target = [Row];
+    fn deref(&self) -> &[Row] {
+        self.rows.get(..self.len).unwrap_or(&[])
+    }
+}
+
+impl IntoIterator for Table {
+    type Item = Row;
+    type IntoIter = core::iter::Take<core::array::IntoIter<Row, MAX_ROWS>>;
+    fn into_iter(self) -> Self::IntoIter {
+        self.rows.into_iter().take(self.len)
+    }
+}
+
+/// The report: every kernel of the [registry](crate::registry) on a miss and on a hit (and its
+/// other paths), measured with `Counted<f32>` on the lectures' worked examples (sphere centre
+/// (5,5,5), radius 3; the miss ray from the origin along (1,3,4)/√26, the hit ray from (1,0,1)
+/// along (1,2,1)/√6), spheres, then planes, then triangles.
 ///
 /// Triangles: A = (0,0,0), B = (4,0,0), C = (0,3,0) and rays along (0,0,−1) (`Ray::new`,
 /// interval (0, inf)): the hit from (1,1,5) (t = 5, u = 1/4, v = 1/3), the miss from (3,2,5)
@@ -316,63 +368,110 @@ pub struct Row {
 /// everything before the division), `zero edge` and `doubtful` from (1,1,5) through the point
 /// (2,0,0) of edge AB (the exact fallbacks, both hits: the watertight kernel's `f64` edge
 /// functions are counted, the focal kernel's exact predicate is not), and `per ray` the setup
-/// a query does once per ray ([`Shear::new`](crate::triangle::Shear::new),
-/// [`FocalRays::new`](crate::triangle::FocalRays::new)). `bound` is the conservative
-/// line–sphere culling test of [`Bound::may_hit`](crate::bounds::Bound::may_hit), per ray and
-/// mesh.
+/// a query does once per ray (where there is any: [`Shear::new`](crate::triangle::Shear::new),
+/// [`FocalRays::new`](crate::triangle::FocalRays::new)). The precomputed methods are counted
+/// as their [`TriangleKernel`](crate::triangle::TriangleKernel) runs them, precomputing on
+/// the fly (the study separates the two). Besides the kernels: `geometric-prepared` (the
+/// geometric test with `T` and `c²` prepared per eye), `sphere-point` and `sphere-surface`
+/// (the hit point, and the point with its normal), and `bound`, the conservative line–sphere
+/// culling test of [`Bound::may_hit`](crate::bounds::Bound::may_hit), per ray and mesh.
 #[must_use]
-pub fn table() -> [Row; 37] {
+pub fn table() -> Table {
+    use crate::registry::{Kernel, Prim};
+    let mut t = Table::new();
+    let ex = examples::Examples::new();
+    for prim in Prim::ALL {
+        for k in Kernel::of(prim) {
+            k.visit(examples::Paths { t: &mut t, ex: &ex });
+        }
+        if prim == Prim::Sphere {
+            examples::sphere_extras(&mut t, &ex);
+        }
+    }
+    examples::bound(&mut t, &ex);
+    t
+}
+
+mod examples {
+    //! The worked examples of [`table`](super::table) and the measurement of each path.
+
+    use glam::Vec3;
+
+    use super::{Counted, OpCounts, Table, measure};
     use crate::plane::{self, FocalPlane, Plane, PlanePacket};
     use crate::ray::{Ray, RayPacket};
-    use crate::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
+    use crate::registry::{Kernel, Visitor};
+    use crate::sphere::focal::FocalKernel;
     use crate::sphere::{self as sp, FocalSphere, Geometric, SphereKernel, SpherePacket};
     use crate::triangle::focal as tf;
     use crate::triangle::{
-        Cramer, Cull, FocalRays, FocalTriangle, Moller, Shear, Triangle, TriangleKernel,
-        TrianglePacket, Watertight,
+        Cull, FocalRays, FocalTriangle, Triangle, TriangleKernel, TrianglePacket,
     };
-    use glam::Vec3;
 
     type C = Counted<f32>;
-    let ball = sp::Sphere::new(Vec3::splat(5.0), 3.0);
-    let miss = Ray::new(Vec3::ZERO, Vec3::new(1.0, 3.0, 4.0).normalize());
-    let hit = Ray::new(
-        Vec3::new(1.0, 0.0, 1.0),
-        Vec3::new(1.0, 2.0, 1.0).normalize(),
-    );
-    // A ray grazing the rim of a sphere 2^16 radii away: the guard cannot decide it.
-    let far = sp::Sphere::new(Vec3::new(65536.0, 1.0, 0.0), 1.0);
-    let graze = Ray::new(Vec3::ZERO, Vec3::X);
 
-    fn count<K: SphereKernel>(r: &Ray, s: &sp::Sphere) -> OpCounts {
+    /// The lectures' sphere and rays, and the triangle and its rays.
+    pub(super) struct Examples {
+        ball: sp::Sphere,
+        miss: Ray,
+        hit: Ray,
+        /// A sphere 2^16 radii away and a ray grazing its rim: the guard cannot decide it.
+        far: sp::Sphere,
+        graze: Ray,
+        wall: Plane,
+        behind: Plane,
+        tri: Triangle,
+        t_hit: Ray,
+        t_miss: Ray,
+        t_beta: Ray,
+        t_behind: Ray,
+        t_edge: Ray,
+    }
+
+    impl Examples {
+        pub(super) fn new() -> Self {
+            let down = Vec3::new(0.0, 0.0, -1.0);
+            Examples {
+                ball: sp::Sphere::new(Vec3::splat(5.0), 3.0),
+                miss: Ray::new(Vec3::ZERO, Vec3::new(1.0, 3.0, 4.0).normalize()),
+                hit: Ray::new(
+                    Vec3::new(1.0, 0.0, 1.0),
+                    Vec3::new(1.0, 2.0, 1.0).normalize(),
+                ),
+                far: sp::Sphere::new(Vec3::new(65536.0, 1.0, 0.0), 1.0),
+                graze: Ray::new(Vec3::ZERO, Vec3::X),
+                wall: Plane::new(Vec3::new(2.0, 0.0, 0.0), Vec3::X),
+                behind: Plane::new(Vec3::new(-2.0, 0.0, 0.0), Vec3::X),
+                tri: Triangle::new(
+                    Vec3::ZERO,
+                    Vec3::new(4.0, 0.0, 0.0),
+                    Vec3::new(0.0, 3.0, 0.0),
+                ),
+                t_hit: Ray::new(Vec3::new(1.0, 1.0, 5.0), down),
+                t_miss: Ray::new(Vec3::new(3.0, 2.0, 5.0), down),
+                t_beta: Ray::new(Vec3::new(-1.0, 1.0, 5.0), down),
+                t_behind: Ray::new(Vec3::new(1.0, 1.0, -5.0), down),
+                t_edge: Ray::new(Vec3::new(1.0, 1.0, 5.0), Vec3::new(1.0, -1.0, -5.0)),
+            }
+        }
+    }
+
+    fn sphere<K: SphereKernel>(r: &Ray, s: &sp::Sphere) -> OpCounts {
         let (rp, sp) = (RayPacket::<C>::splat(r), SpherePacket::<C>::splat(s));
         measure(|| K::roots(&rp, &sp)).1
     }
-    fn focal<K: FocalKernel>(r: &Ray, e: &FocalSphere<f32>) -> OpCounts {
-        let (rp, ep) = (RayPacket::<C>::splat(r), FocalSphere::<C>::splat(e));
+
+    fn focal<K: FocalKernel>(r: &Ray, s: &sp::Sphere, guarded: bool) -> OpCounts {
+        let e = if guarded {
+            FocalSphere::new(r.origin(), s)
+        } else {
+            FocalSphere::unguarded(r.origin(), s)
+        };
+        let (rp, ep) = (RayPacket::<C>::splat(r), FocalSphere::<C>::splat(&e));
         measure(|| K::roots(&rp, &ep)).1
     }
-    let prepared = |r: &Ray| {
-        let rp = RayPacket::<C>::splat(r);
-        let p = measure(|| Geometric::prepare(rp.origin(), &SpherePacket::splat(&ball))).0;
-        measure(|| Geometric::roots_prepared(&rp, &p)).1
-    };
-    let surface = |r: &Ray, t: f32, with: bool| {
-        let rp = RayPacket::<C>::splat(r);
-        let s = SpherePacket::<C>::splat(&ball);
-        let tc = Counted(t);
-        measure(|| {
-            if with {
-                let _ = sp::surface(&rp, &s, tc);
-            } else {
-                let _ = rp.origin().mul_add(rp.dir(), tc);
-            }
-        })
-        .1
-    };
-    let wall = Plane::new(Vec3::new(2.0, 0.0, 0.0), Vec3::X);
-    let behind = Plane::new(Vec3::new(-2.0, 0.0, 0.0), Vec3::X);
-    let plane_count = |p: &Plane, focal: bool| {
+
+    fn plane(p: &Plane, focal: bool) -> OpCounts {
         let rp = RayPacket::<C>::splat(&Ray::new(Vec3::ZERO, Vec3::X));
         if focal {
             let f = FocalPlane::new(Vec3::ZERO, p);
@@ -381,120 +480,128 @@ pub fn table() -> [Row; 37] {
             let pp = PlanePacket::<C>::splat(p);
             measure(|| plane::intersect_lanes(&rp, &pp)).1
         }
-    };
-    let tri = Triangle::new(
-        Vec3::ZERO,
-        Vec3::new(4.0, 0.0, 0.0),
-        Vec3::new(0.0, 3.0, 0.0),
-    );
-    let down = Vec3::new(0.0, 0.0, -1.0);
-    let t_hit = Ray::new(Vec3::new(1.0, 1.0, 5.0), down);
-    let t_miss = Ray::new(Vec3::new(3.0, 2.0, 5.0), down);
-    let t_beta = Ray::new(Vec3::new(-1.0, 1.0, 5.0), down);
-    let t_behind = Ray::new(Vec3::new(1.0, 1.0, -5.0), down);
-    let t_edge = Ray::new(Vec3::new(1.0, 1.0, 5.0), Vec3::new(1.0, -1.0, -5.0));
+    }
+
     // Setup on counted lanes runs inside `measure` too (counts discarded): the counters are
     // global, and only what runs under its lock stays out of concurrent measurements.
-    fn tri_count<K: TriangleKernel>(r: &Ray, t: &Triangle) -> OpCounts {
+    fn triangle<K: TriangleKernel>(r: &Ray, t: &Triangle) -> OpCounts {
         let rp = RayPacket::<C>::splat(r);
         let pre = measure(|| K::prepare(&rp)).0;
         let tp = TrianglePacket::<C>::splat(t);
         measure(|| K::intersect(&rp, &pre, &tp, Cull::None)).1
     }
-    let focal_tri = |r: &Ray| {
-        let e = FocalTriangle::<C>::splat(&FocalTriangle::new(r.origin(), &tri));
+
+    fn focal_triangle(r: &Ray, t: &Triangle) -> OpCounts {
+        let e = FocalTriangle::<C>::splat(&FocalTriangle::new(r.origin(), t));
         let fr = measure(|| FocalRays::<C>::new(&RayPacket::splat(r))).0;
         measure(|| tf::kernel(fr.scaled(), &e, Cull::None)).1
-    };
-    let per_ray = |focal: bool| {
-        let rp = RayPacket::<C>::splat(&t_hit);
-        if focal {
-            measure(|| FocalRays::new(&rp)).1
-        } else {
-            measure(|| Shear::new(&rp)).1
+    }
+
+    /// Every path of one kernel into the table.
+    pub(super) struct Paths<'a> {
+        pub(super) t: &'a mut Table,
+        pub(super) ex: &'a Examples,
+    }
+
+    impl Visitor for Paths<'_> {
+        type Output = ();
+
+        fn sphere<K: SphereKernel>(self, k: Kernel) {
+            let ex = self.ex;
+            self.t
+                .push(k.name(), "miss", sphere::<K>(&ex.miss, &ex.ball));
+            self.t.push(k.name(), "hit", sphere::<K>(&ex.hit, &ex.ball));
         }
-    };
-    let bound = {
+
+        fn focal_sphere<K: FocalKernel>(self, k: Kernel, guarded: bool) {
+            let ex = self.ex;
+            let n = k.name();
+            self.t
+                .push(n, "miss", focal::<K>(&ex.miss, &ex.ball, guarded));
+            self.t
+                .push(n, "hit", focal::<K>(&ex.hit, &ex.ball, guarded));
+            if guarded {
+                let doubtful = focal::<K>(&ex.graze, &ex.far, guarded);
+                self.t.push(n, "doubtful", doubtful);
+            }
+        }
+
+        fn plane(self, k: Kernel) {
+            self.t.push(k.name(), "miss", plane(&self.ex.behind, false));
+            self.t.push(k.name(), "hit", plane(&self.ex.wall, false));
+        }
+
+        fn focal_plane(self, k: Kernel) {
+            self.t.push(k.name(), "miss", plane(&self.ex.behind, true));
+            self.t.push(k.name(), "hit", plane(&self.ex.wall, true));
+        }
+
+        fn triangle<K: TriangleKernel>(self, k: Kernel) {
+            let (ex, n) = (self.ex, k.name());
+            let per_ray = measure(|| K::prepare(&RayPacket::<C>::splat(&ex.t_hit))).1;
+            if per_ray != OpCounts::default() {
+                self.t.push(n, "per ray", per_ray);
+            }
+            if k == Kernel::Cramer {
+                self.t
+                    .push(n, "miss (β)", triangle::<K>(&ex.t_beta, &ex.tri));
+            }
+            self.t.push(n, "miss", triangle::<K>(&ex.t_miss, &ex.tri));
+            self.t
+                .push(n, "behind", triangle::<K>(&ex.t_behind, &ex.tri));
+            self.t.push(n, "hit", triangle::<K>(&ex.t_hit, &ex.tri));
+            if k == Kernel::Watertight {
+                self.t
+                    .push(n, "zero edge", triangle::<K>(&ex.t_edge, &ex.tri));
+            }
+        }
+
+        fn focal_triangle(self, k: Kernel) {
+            let (ex, n) = (self.ex, k.name());
+            let rp = RayPacket::<C>::splat(&ex.t_hit);
+            self.t.push(n, "per ray", measure(|| FocalRays::new(&rp)).1);
+            self.t.push(n, "miss", focal_triangle(&ex.t_miss, &ex.tri));
+            self.t
+                .push(n, "behind", focal_triangle(&ex.t_behind, &ex.tri));
+            self.t.push(n, "hit", focal_triangle(&ex.t_hit, &ex.tri));
+            self.t
+                .push(n, "doubtful", focal_triangle(&ex.t_edge, &ex.tri));
+        }
+    }
+
+    /// The prepared geometric test and the hit point with and without its normal.
+    pub(super) fn sphere_extras(t: &mut Table, ex: &Examples) {
+        let ball = ex.ball;
+        let prepared = |r: &Ray| {
+            let rp = RayPacket::<C>::splat(r);
+            let p = measure(|| Geometric::prepare(rp.origin(), &SpherePacket::splat(&ball))).0;
+            measure(|| Geometric::roots_prepared(&rp, &p)).1
+        };
+        let surface = |r: &Ray, t: f32, with: bool| {
+            let rp = RayPacket::<C>::splat(r);
+            let s = SpherePacket::<C>::splat(&ball);
+            let tc = Counted(t);
+            measure(|| {
+                if with {
+                    let _ = sp::surface(&rp, &s, tc);
+                } else {
+                    let _ = rp.origin().along(rp.dir(), tc);
+                }
+            })
+            .1
+        };
+        t.push("geometric-prepared", "miss", prepared(&ex.miss));
+        t.push("geometric-prepared", "hit", prepared(&ex.hit));
+        t.push("sphere-point", "hit", surface(&ex.hit, 4.898979, false));
+        t.push("sphere-surface", "hit", surface(&ex.hit, 4.898979, true));
+    }
+
+    /// The bounding-sphere test per ray and mesh.
+    pub(super) fn bound(t: &mut Table, ex: &Examples) {
         let b = crate::bounds::Bound::new(&sp::Sphere::new(Vec3::new(2.0, 1.5, 0.0), 2.5));
-        let rp = RayPacket::<C>::splat(&t_hit);
-        measure(|| b.may_hit(&rp)).1
-    };
-    let row = |kernel, path, counts| Row {
-        kernel,
-        path,
-        counts,
-    };
-    [
-        row("quadratic", "miss", count::<sp::Quadratic>(&miss, &ball)),
-        row("quadratic", "hit", count::<sp::Quadratic>(&hit, &ball)),
-        row(
-            "quadratic-unit",
-            "miss",
-            count::<sp::QuadraticUnit>(&miss, &ball),
-        ),
-        row(
-            "quadratic-unit",
-            "hit",
-            count::<sp::QuadraticUnit>(&hit, &ball),
-        ),
-        row("geometric", "miss", count::<Geometric>(&miss, &ball)),
-        row("geometric", "hit", count::<Geometric>(&hit, &ball)),
-        row("geometric-prepared", "miss", prepared(&miss)),
-        row("geometric-prepared", "hit", prepared(&hit)),
-        row("robust", "miss", count::<sp::Robust>(&miss, &ball)),
-        row("robust", "hit", count::<sp::Robust>(&hit, &ball)),
-        row(
-            "focal",
-            "miss",
-            focal::<Focal>(&miss, &FocalSphere::new(miss.origin(), &ball)),
-        ),
-        row(
-            "focal",
-            "hit",
-            focal::<Focal>(&hit, &FocalSphere::new(hit.origin(), &ball)),
-        ),
-        row(
-            "focal",
-            "doubtful",
-            focal::<Focal>(&graze, &FocalSphere::new(Vec3::ZERO, &far)),
-        ),
-        row(
-            "focal-unguarded",
-            "miss",
-            focal::<FocalUnguarded>(&miss, &FocalSphere::unguarded(miss.origin(), &ball)),
-        ),
-        row(
-            "focal-unguarded",
-            "hit",
-            focal::<FocalUnguarded>(&hit, &FocalSphere::unguarded(hit.origin(), &ball)),
-        ),
-        row("sphere-point", "hit", surface(&hit, 4.898979, false)),
-        row("sphere-surface", "hit", surface(&hit, 4.898979, true)),
-        row("plane", "miss", plane_count(&behind, false)),
-        row("plane", "hit", plane_count(&wall, false)),
-        row("plane-focal", "miss", plane_count(&behind, true)),
-        row("plane-focal", "hit", plane_count(&wall, true)),
-        row("cramer", "miss (β)", tri_count::<Cramer>(&t_beta, &tri)),
-        row("cramer", "miss", tri_count::<Cramer>(&t_miss, &tri)),
-        row("cramer", "hit", tri_count::<Cramer>(&t_hit, &tri)),
-        row("moller", "miss", tri_count::<Moller>(&t_miss, &tri)),
-        row("moller", "behind", tri_count::<Moller>(&t_behind, &tri)),
-        row("moller", "hit", tri_count::<Moller>(&t_hit, &tri)),
-        row("watertight", "per ray", per_ray(false)),
-        row("watertight", "miss", tri_count::<Watertight>(&t_miss, &tri)),
-        row("watertight", "hit", tri_count::<Watertight>(&t_hit, &tri)),
-        row(
-            "watertight",
-            "zero edge",
-            tri_count::<Watertight>(&t_edge, &tri),
-        ),
-        row("triangle-focal", "per ray", per_ray(true)),
-        row("triangle-focal", "miss", focal_tri(&t_miss)),
-        row("triangle-focal", "behind", focal_tri(&t_behind)),
-        row("triangle-focal", "hit", focal_tri(&t_hit)),
-        row("triangle-focal", "doubtful", focal_tri(&t_edge)),
-        row("bound", "per mesh", bound),
-    ]
+        let rp = RayPacket::<C>::splat(&ex.t_hit);
+        t.push("bound", "per mesh", measure(|| b.may_hit(&rp)).1);
+    }
 }
 
 /// Writes the report as a Markdown table (the README's) or, with `csv`, as

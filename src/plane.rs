@@ -7,9 +7,10 @@
 //! t = ((a − o)·n) / (d·n)
 //! ```
 //!
-//! **Operation count per lane**: 6 mul, 7 add, 1 div, 2 cmp, hit or miss. The focal variant
-//! ([`FocalPlane`]) caches the numerator `(a − E)·n` per plane for rays from the eye `E`:
-//! 3 mul, 2 add, 1 div, 2 cmp per ray.
+//! **Operation count per lane**, hit or miss: `ops plane/miss: 6 mul, 7 add, 1 div, 2 cmp`,
+//! `ops plane/hit: 6 mul, 7 add, 1 div, 2 cmp`. The focal variant ([`FocalPlane`]) caches
+//! the numerator `(a − E)·n` per plane for rays from the eye `E`:
+//! `ops plane-focal/miss: 3 mul, 2 add, 1 div, 2 cmp` per ray, the same on a hit.
 //!
 //! **Edge cases.** A ray parallel to the plane (`d·n = 0`) gives `t = ±inf` or NaN, which fails
 //! the interval test: a miss, including the ray that lies in the plane. A zero or non-finite

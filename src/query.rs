@@ -227,14 +227,14 @@ impl<L: Lane> Hits<L> {
                 .unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN))
         };
         let c = V3::<L>::from_fn(|i| get(i).center());
-        let point = rays.origin.mul_add(rays.dir, best.t);
+        let point = rays.origin.along(rays.dir, best.t);
         let n = unit(point - c, best.mask, |i| {
             let (o, d, c) = (
                 rays.origin.precise_lane(i),
                 rays.dir.precise_lane(i),
                 c.precise_lane(i),
             );
-            o.mul_add(d, best.t.precise_lane(i)) - c
+            o.along(d, best.t.precise_lane(i)) - c
         });
         // Entry roots carry u = 0, exit roots u = 1 (see `sphere_hit`).
         let front = best.mask & best.u.lt(L::from_f32(0.5));
@@ -268,7 +268,7 @@ impl<L: Lane> Hits<L> {
             );
             (b - a).cross(c - a)
         });
-        let point = rays.origin.mul_add(rays.dir, best.t);
+        let point = rays.origin.along(rays.dir, best.t);
         let front = if cull.back() {
             best.mask
         } else {
@@ -295,7 +295,7 @@ impl<L: Lane> Hits<L> {
                 .map_or(Vec3::ZERO, |p| p.normal)
         });
         let n = unit(normal, best.mask, |i| normal.precise_lane(i));
-        let point = rays.origin.mul_add(rays.dir, best.t);
+        let point = rays.origin.along(rays.dir, best.t);
         let front = if cull.back() {
             best.mask
         } else {

@@ -86,7 +86,7 @@ impl Ray {
     #[must_use]
     pub fn at(&self, t: f32) -> Vec3 {
         V3::<f32>::from(self.origin)
-            .mul_add(self.dir.into(), t)
+            .along(self.dir.into(), t)
             .into()
     }
 

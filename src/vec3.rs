@@ -108,10 +108,11 @@ impl<L: Lane> V3<L> {
         }
     }
 
-    /// `self + d·t` (a point along a ray): 3 mul, 3 add.
+    /// `self + d·t`, the point at `t` along direction `d` from `self`: 3 mul, 3 add, each
+    /// rounded (not a fused multiply-add: the same bits on every target).
     #[inline(always)]
     #[must_use]
-    pub fn mul_add(self, d: Self, t: L) -> Self {
+    pub fn along(self, d: Self, t: L) -> Self {
         V3 {
             x: self.x + d.x * t,
             y: self.y + d.y * t,

@@ -28,17 +28,15 @@ use core::hash::Hasher as _;
 
 use glam::Vec3;
 
+use crate::hit::LaneHit;
 use crate::lane::{Lane, MAX_LANES, Mask};
 use crate::plane::{self, FocalPlane, Plane, PlanePacket};
 use crate::ray::RayPacket;
-use crate::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
-use crate::sphere::{
-    EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust, Roots, Sphere,
-    SphereKernel, SpherePacket,
-};
+use crate::registry::{Kernel, Visitor};
+use crate::sphere::focal::FocalKernel;
+use crate::sphere::{FocalSphere, Roots, Sphere, SphereKernel, SpherePacket};
 use crate::triangle::{
-    self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout,
-    KenslerShirley, Moller, Plucker, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
+    self, Cull, FocalRays, FocalTriangle, Triangle, TriangleKernel, TrianglePacket,
 };
 use crate::vec3::V3;
 
@@ -53,29 +51,12 @@ pub const UV_TOLERANCE: f64 = 2e-5;
 /// and `moller` too except for `t` on needles (a documented limit).
 pub const COND_FACTOR: f64 = 4.0;
 
-/// The primitive a case tests.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kind {
-    /// `sphere` lines: 10 inputs.
-    Sphere,
-    /// `plane` lines: 12 inputs.
-    Plane,
-    /// `triangle` lines: 15 inputs.
-    Triangle,
-}
+/// The primitive a case tests: `sphere` lines have 10 inputs, `plane` lines 12, `triangle`
+/// lines 15 ([`Kind::inputs`]).
+pub use crate::registry::Prim as Kind;
 
 impl Kind {
-    /// The keyword that starts the line.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Kind::Sphere => "sphere",
-            Kind::Plane => "plane",
-            Kind::Triangle => "triangle",
-        }
-    }
-
-    /// Number of input numbers.
+    /// Number of input numbers of a vector line.
     #[must_use]
     pub fn inputs(self) -> usize {
         match self {
@@ -303,129 +284,11 @@ pub fn cases(text: &str) -> impl Iterator<Item = (u32, Result<Case, ParseError>)
     })
 }
 
-/// A formulation, as the checker names it.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Method {
-    /// [`Quadratic`]: spheres.
-    Quadratic,
-    /// [`QuadraticUnit`]: spheres, unit directions.
-    QuadraticUnit,
-    /// [`Geometric`]: spheres, unit directions.
-    Geometric,
-    /// [`Robust`]: spheres.
-    Robust,
-    /// The focal caches: spheres ([`Focal`], guarded, unit directions), planes
-    /// ([`FocalPlane`]) and triangles ([`FocalTriangle`], any direction); per case the eye is
-    /// the ray origin.
-    Focal,
-    /// [`FocalUnguarded`]: spheres, unit directions.
-    FocalUnguarded,
-    /// The ray–plane test.
-    Plane,
-    /// [`Cramer`]: triangles (lecture 002).
-    Cramer,
-    /// [`Moller`]: triangles (Möller–Trumbore, division deferred).
-    Moller,
-    /// [`Watertight`]: triangles (Woop, Benthin, Wald 2013).
-    Watertight,
-    /// [`Pbrt`]: spheres (pbrt-v4's sphere test, without intervals).
-    Pbrt,
-    /// [`EmbreeSphere`]: spheres (Embree's sphere test).
-    EmbreeSphere,
-    /// [`Badouel`]: triangles (Badouel 1990: plane, then a 2-D test (precomputed plane)).
-    Badouel,
-    /// [`Plucker`]: triangles (Plücker edge tests relative to the origin (Segura–Feito 1998, as in Embree)).
-    Plucker,
-    /// [`Wald`]: triangles (Wald 2004: precomputed projection).
-    Wald,
-    /// [`HavelHerout`]: triangles (Havel–Herout 2010: precomputed planes).
-    HavelHerout,
-    /// [`KenslerShirley`]: triangles (Kensler–Shirley 2006).
-    KenslerShirley,
-    /// [`BaldwinWeber`]: triangles (Baldwin–Weber 2016: precomputed affine transform).
-    BaldwinWeber,
-}
+/// A formulation, as the checker names it: the [registry](crate::registry)'s methods, each
+/// running its kernel for the primitive of a case.
+pub use crate::registry::Method;
 
 impl Method {
-    /// Every method, in report order.
-    pub const ALL: [Method; 18] = [
-        Method::Quadratic,
-        Method::QuadraticUnit,
-        Method::Geometric,
-        Method::Robust,
-        Method::Focal,
-        Method::FocalUnguarded,
-        Method::Plane,
-        Method::Cramer,
-        Method::Moller,
-        Method::Watertight,
-        Method::Pbrt,
-        Method::EmbreeSphere,
-        Method::Badouel,
-        Method::Plucker,
-        Method::Wald,
-        Method::HavelHerout,
-        Method::KenslerShirley,
-        Method::BaldwinWeber,
-    ];
-
-    /// The checker's name.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Quadratic => Quadratic::NAME,
-            Method::QuadraticUnit => QuadraticUnit::NAME,
-            Method::Geometric => Geometric::NAME,
-            Method::Robust => Robust::NAME,
-            Method::Focal => Focal::NAME,
-            Method::FocalUnguarded => FocalUnguarded::NAME,
-            Method::Plane => "plane",
-            Method::Cramer => Cramer::NAME,
-            Method::Moller => Moller::NAME,
-            Method::Watertight => Watertight::NAME,
-            Method::Pbrt => Pbrt::NAME,
-            Method::EmbreeSphere => EmbreeSphere::NAME,
-            Method::Badouel => Badouel::NAME,
-            Method::Plucker => Plucker::NAME,
-            Method::Wald => Wald::NAME,
-            Method::HavelHerout => HavelHerout::NAME,
-            Method::KenslerShirley => KenslerShirley::NAME,
-            Method::BaldwinWeber => BaldwinWeber::NAME,
-        }
-    }
-
-    /// Looks a name up.
-    #[must_use]
-    pub fn parse(name: &str) -> Option<Method> {
-        Method::ALL.into_iter().find(|m| m.name() == name)
-    }
-
-    /// True when the method tests this kind of primitive.
-    #[must_use]
-    pub fn applies(self, kind: Kind) -> bool {
-        match kind {
-            Kind::Sphere => !matches!(self, Method::Plane) && !self.triangles_only(),
-            Kind::Plane => matches!(self, Method::Plane | Method::Focal),
-            Kind::Triangle => matches!(self, Method::Focal) || self.triangles_only(),
-        }
-    }
-
-    /// The methods that test triangles only.
-    fn triangles_only(self) -> bool {
-        matches!(
-            self,
-            Method::Cramer
-                | Method::Moller
-                | Method::Watertight
-                | Method::Badouel
-                | Method::Plucker
-                | Method::Wald
-                | Method::HavelHerout
-                | Method::KenslerShirley
-                | Method::BaldwinWeber
-        )
-    }
-
     /// The crate's recommended general method for a kind (any direction, any origin).
     #[must_use]
     pub fn recommended(kind: Kind) -> Option<Method> {
@@ -465,6 +328,7 @@ mod limits {
     //! f64). They follow the error bounds in each kernel's documentation.
 
     use super::{Case, Kind, Limit, Method, T_TOLERANCE};
+    use crate::registry::ErrorModel;
     use crate::vec3::V3;
 
     const U: f64 = 1.0 / 16_777_216.0;
@@ -488,17 +352,14 @@ mod limits {
     /// False for a sphere case whose direction is not unit (`||d|² − 1| > 2^-20`) given to a
     /// method that needs one.
     pub(super) fn unit_direction(m: Method, case: &Case) -> bool {
-        let needs_unit = matches!(
-            m,
-            Method::QuadraticUnit | Method::Geometric | Method::Focal | Method::FocalUnguarded
-        );
+        let needs_unit = m.kernel(case.kind).is_some_and(|k| k.needs_unit());
         let d = v(case, 3);
         case.kind != Kind::Sphere || !needs_unit || (d.dot(d) - 1.0).abs() <= 1.0 / 1_048_576.0
     }
 
     /// The triangle methods' limits on the values of a hit: measured error models
     /// (`tests/vectors/triangle_*.txt`) against the case's tolerance ([`super::tolerance`]).
-    fn triangle(m: Method, case: &Case) -> Limit {
+    fn triangle(model: ErrorModel, case: &Case) -> Limit {
         let (o, d, a, b, c) = (v(case, 0), v(case, 3), v(case, 6), v(case, 9), v(case, 12));
         let n = (b - a).cross(c - a);
         let area2 = sqrt(n.dot(n));
@@ -512,8 +373,8 @@ mod limits {
         // Aspect ratio (longest edge over its height) = longest² / (2·area).
         let aspect = longest / area2;
         let tol_t = super::tolerance(case, 0);
-        match m {
-            Method::Cramer | Method::Moller | Method::Plucker | Method::KenslerShirley => {
+        match model {
+            ErrorModel::Needle => {
                 // t is a triple product over the determinant, each rounded at the scale of
                 // |e1|·|e2|·|s|: on needles the relative error of t grows with the aspect
                 // ratio while t itself stays well conditioned. Measured (triangle_needle.txt):
@@ -524,7 +385,7 @@ mod limits {
                 }
                 Limit::Inside
             }
-            Method::Badouel | Method::Wald | Method::HavelHerout | Method::BaldwinWeber => {
+            ErrorModel::Record => {
                 // A record computed once per triangle (plane, lines, transform) carries
                 // coordinates of size M (the largest |coordinate| of the origin and the
                 // vertices) into every test: the plane offset cancels at the scale of M against
@@ -558,9 +419,10 @@ mod limits {
     }
 
     pub(super) fn check(m: Method, case: &Case) -> Limit {
-        if !m.applies(case.kind) {
+        let Some(kernel) = m.kernel(case.kind) else {
             return Limit::Outside("method does not apply to this kind");
-        }
+        };
+        let model = kernel.error_model();
         // Bad input must be a miss for every method.
         let all_finite = case.input[..case.kind.inputs()]
             .iter()
@@ -569,7 +431,7 @@ mod limits {
             return Limit::Inside;
         }
         if case.kind == Kind::Triangle {
-            return triangle(m, case);
+            return triangle(model, case);
         }
         let o = v(case, 0);
         let d = v(case, 3);
@@ -603,11 +465,8 @@ mod limits {
         };
         let c = sqrt(c2);
         let tol = 0.5 * T_TOLERANCE;
-        match m {
-            Method::Quadratic
-            | Method::QuadraticUnit
-            | Method::Geometric
-            | Method::FocalUnguarded => {
+        match model {
+            ErrorModel::Textbook => {
                 // The constant term c² − r² (or c² − v²) carries an error of about 16·2^-24·c²:
                 // decisions need the rim margin above twice that, and t's error
                 // E/(2√(margin)) + 4·2^-24·(|μ| + √disc) must stay within half the tolerance.
@@ -621,7 +480,7 @@ mod limits {
                 }
                 Limit::Inside
             }
-            Method::Robust | Method::Pbrt | Method::EmbreeSphere => {
+            ErrorModel::RobustSphere => {
                 // |l| carries an error of about 8·2^-24·|f|; c = f·f − r² about 4·2^-24·|f|².
                 let el = 8.0 * U * c;
                 let l = sqrt(l2);
@@ -642,10 +501,9 @@ mod limits {
                 }
                 Limit::Inside
             }
-            // Exact decisions and t within 2^-17 for unit directions and any c/r.
-            Method::Focal | Method::Plane => Limit::Inside,
-            // Triangle methods never reach here (only sphere cases are limited).
-            _ => Limit::Inside,
+            // Exact decisions and t within 2^-17 for unit directions and any c/r (focal); the
+            // triangle models never reach here (only sphere cases are limited below).
+            ErrorModel::Exact | ErrorModel::Needle | ErrorModel::Record => Limit::Inside,
         }
     }
 }
@@ -690,136 +548,146 @@ fn run<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome
     }
 }
 
-/// Evaluates up to `L::LANES` cases of one kind in one packet.
+/// Evaluates up to `L::LANES` cases of one kind in one packet: the method's kernel for the
+/// kind, through the [registry](crate::registry).
 fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome]) {
     crate::lane::assert_fits::<L>();
-    let kind = cases[0].kind;
-    if !method.applies(kind) {
-        out.iter_mut().for_each(|o| *o = Outcome::default());
-        return;
+    match method.kernel(cases[0].kind) {
+        Some(k) => k.visit(Batch::<L>::new(cases, out)),
+        None => out.iter_mut().for_each(|o| *o = Outcome::default()),
     }
-    let n = cases.len();
-    let get = |i: usize| cases[i.min(n - 1)];
-    let ray = RayPacket::<L>::new(
-        V3::from_fn(|i| get(i).origin()),
-        V3::from_fn(|i| get(i).dir()),
-        L::from_f32(0.0),
-        L::from_f32(f32::INFINITY),
-    );
-    match kind {
-        Kind::Sphere => {
-            let spheres = || SpherePacket::<L>::from_spheres(&sphere_list(cases));
-            let roots: Roots<L> = match method {
-                Method::Quadratic => Quadratic::roots(&ray, &spheres()),
-                Method::QuadraticUnit => QuadraticUnit::roots(&ray, &spheres()),
-                Method::Geometric => Geometric::roots(&ray, &spheres()),
-                Method::Robust => Robust::roots(&ray, &spheres()),
-                Method::Pbrt => Pbrt::roots(&ray, &spheres()),
-                Method::EmbreeSphere => EmbreeSphere::roots(&ray, &spheres()),
-                Method::Focal | Method::FocalUnguarded => {
-                    let mut e =
-                        [FocalSphere::<f32>::new(Vec3::ZERO, &Sphere::new(Vec3::ZERO, f32::NAN));
-                            MAX_LANES];
-                    for (k, c) in cases.iter().enumerate() {
-                        e[k] = if method == Method::Focal {
-                            FocalSphere::new(c.origin(), &c.sphere())
-                        } else {
-                            FocalSphere::unguarded(c.origin(), &c.sphere())
-                        };
-                    }
-                    let cache = FocalSphere::<L>::gather(&e[..n]);
-                    if method == Method::Focal {
-                        Focal::roots(&ray, &cache)
-                    } else {
-                        FocalUnguarded::roots(&ray, &cache)
-                    }
-                }
-                _ => Roots::miss(),
+}
+
+/// One packet of cases (one ray per case, interval `(0, +inf)`) and where their outcomes go:
+/// the [`Visitor`] that runs any kernel over it.
+struct Batch<'a, L: Lane> {
+    cases: &'a [Case],
+    out: &'a mut [Outcome],
+    ray: RayPacket<L>,
+}
+
+impl<'a, L: Lane<Scalar = f32>> Batch<'a, L> {
+    fn new(cases: &'a [Case], out: &'a mut [Outcome]) -> Self {
+        let ray = RayPacket::<L>::new(
+            V3::from_fn(|i| case_lane(cases, i).origin()),
+            V3::from_fn(|i| case_lane(cases, i).dir()),
+            L::from_f32(0.0),
+            L::from_f32(f32::INFINITY),
+        );
+        Batch { cases, out, ray }
+    }
+
+    /// The case of lane `i` (the last case in the lanes past the cases).
+    fn get(&self, i: usize) -> Case {
+        case_lane(self.cases, i)
+    }
+
+    /// Writes sphere roots.
+    fn roots(self, roots: Roots<L>) {
+        for (k, o) in self.out.iter_mut().enumerate() {
+            let (t, m) = roots.lane(k);
+            *o = Outcome {
+                applicable: true,
+                values: Values {
+                    n: m as u8,
+                    v: [t[0], t[1], 0.0],
+                },
             };
-            for (k, o) in out.iter_mut().enumerate() {
-                let (t, m) = roots.lane(k);
-                *o = Outcome {
-                    applicable: true,
-                    values: Values {
-                        n: m as u8,
-                        v: [t[0], t[1], 0.0],
-                    },
-                };
-            }
         }
-        Kind::Plane => {
-            let h = if method == Method::Focal {
-                let num =
-                    L::from_f32_fn(|i| FocalPlane::new(get(i).origin(), &get(i).plane()).num());
-                plane::focal_lanes(&ray, num, V3::from_fn(|i| get(i).vec(1)))
-            } else {
-                let planes = PlanePacket::<L> {
-                    point: V3::from_fn(|i| get(i).vec(0)),
-                    normal: V3::from_fn(|i| get(i).vec(1)),
-                };
-                plane::intersect_lanes(&ray, &planes)
+    }
+
+    /// Writes plane hits (`t`) or, with `uv`, triangle hits (`t u v`).
+    fn hits(self, h: LaneHit<L>, uv: bool) {
+        for (k, o) in self.out.iter_mut().enumerate() {
+            let values = match (h.mask.test(k), uv) {
+                (false, _) => Values::MISS,
+                (true, false) => Values {
+                    n: 1,
+                    v: [h.t.lane(k), 0.0, 0.0],
+                },
+                (true, true) => Values {
+                    n: 3,
+                    v: [h.t.lane(k), h.u.lane(k), h.v.lane(k)],
+                },
             };
-            for (k, o) in out.iter_mut().enumerate() {
-                let values = if h.mask.test(k) {
-                    Values {
-                        n: 1,
-                        v: [h.t.lane(k), 0.0, 0.0],
-                    }
-                } else {
-                    Values::MISS
-                };
-                *o = Outcome {
-                    applicable: true,
-                    values,
-                };
-            }
-        }
-        Kind::Triangle => {
-            let tris = TrianglePacket::<L>::from_fn(|i| get(i).triangle());
-            let two_sided = Cull::None;
-            let h = match method {
-                Method::Cramer => tri_lanes::<Cramer, L>(&ray, &tris),
-                Method::Moller => tri_lanes::<Moller, L>(&ray, &tris),
-                Method::Watertight => tri_lanes::<Watertight, L>(&ray, &tris),
-                Method::Badouel => tri_lanes::<Badouel, L>(&ray, &tris),
-                Method::Plucker => tri_lanes::<Plucker, L>(&ray, &tris),
-                Method::Wald => tri_lanes::<Wald, L>(&ray, &tris),
-                Method::HavelHerout => tri_lanes::<HavelHerout, L>(&ray, &tris),
-                Method::KenslerShirley => tri_lanes::<KenslerShirley, L>(&ray, &tris),
-                Method::BaldwinWeber => tri_lanes::<BaldwinWeber, L>(&ray, &tris),
-                _ => {
-                    // A per-case cache with the eye at the ray origin.
-                    let mut e = [FocalTriangle::never(); MAX_LANES];
-                    for (k, c) in cases.iter().enumerate() {
-                        e[k] = FocalTriangle::new(c.origin(), &c.triangle());
-                    }
-                    let cache = FocalTriangle::<L>::gather(&e[..n]);
-                    triangle::focal::intersect_lanes(&FocalRays::new(&ray), &cache, two_sided)
-                }
+            *o = Outcome {
+                applicable: true,
+                values,
             };
-            for (k, o) in out.iter_mut().enumerate() {
-                let values = if h.mask.test(k) {
-                    Values {
-                        n: 3,
-                        v: [h.t.lane(k), h.u.lane(k), h.v.lane(k)],
-                    }
-                } else {
-                    Values::MISS
-                };
-                *o = Outcome {
-                    applicable: true,
-                    values,
-                };
-            }
         }
     }
 }
 
-fn tri_lanes<K: TriangleKernel, L: Lane>(
-    ray: &RayPacket<L>,
-    tris: &TrianglePacket<L>,
-) -> crate::hit::LaneHit<L> {
-    K::intersect(ray, &K::prepare(ray), tris, Cull::None).normalized()
+/// Lane `i`'s case: the last one in the lanes past `cases`.
+fn case_lane(cases: &[Case], i: usize) -> Case {
+    cases[i.min(cases.len() - 1)]
+}
+
+// Each family out of line: their caches (up to 16 lanes of focal entries) then never share
+// one stack frame (the Cortex-M0 has 16 KB of RAM).
+impl<L: Lane<Scalar = f32>> Visitor for Batch<'_, L> {
+    type Output = ();
+
+    #[inline(never)]
+    fn sphere<K: SphereKernel>(self, _: Kernel) {
+        let spheres = SpherePacket::<L>::from_spheres(&sphere_list(self.cases));
+        let roots = K::roots(&self.ray, &spheres);
+        self.roots(roots);
+    }
+
+    #[inline(never)]
+    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) {
+        // A per-case cache with the eye at the ray origin.
+        let mut e =
+            [FocalSphere::<f32>::new(Vec3::ZERO, &Sphere::new(Vec3::ZERO, f32::NAN)); MAX_LANES];
+        for (slot, c) in e.iter_mut().zip(self.cases) {
+            *slot = if guarded {
+                FocalSphere::new(c.origin(), &c.sphere())
+            } else {
+                FocalSphere::unguarded(c.origin(), &c.sphere())
+            };
+        }
+        let cache = FocalSphere::<L>::gather(&e[..self.cases.len().min(MAX_LANES)]);
+        let roots = K::roots(&self.ray, &cache);
+        self.roots(roots);
+    }
+
+    #[inline(never)]
+    fn plane(self, _: Kernel) {
+        let planes = PlanePacket::<L> {
+            point: V3::from_fn(|i| self.get(i).vec(0)),
+            normal: V3::from_fn(|i| self.get(i).vec(1)),
+        };
+        let h = plane::intersect_lanes(&self.ray, &planes);
+        self.hits(h, false);
+    }
+
+    #[inline(never)]
+    fn focal_plane(self, _: Kernel) {
+        let num =
+            L::from_f32_fn(|i| FocalPlane::new(self.get(i).origin(), &self.get(i).plane()).num());
+        let h = plane::focal_lanes(&self.ray, num, V3::from_fn(|i| self.get(i).vec(1)));
+        self.hits(h, false);
+    }
+
+    #[inline(never)]
+    fn triangle<K: TriangleKernel>(self, _: Kernel) {
+        let tris = TrianglePacket::<L>::from_fn(|i| self.get(i).triangle());
+        let h = K::intersect(&self.ray, &K::prepare(&self.ray), &tris, Cull::None).normalized();
+        self.hits(h, true);
+    }
+
+    #[inline(never)]
+    fn focal_triangle(self, _: Kernel) {
+        // A per-case cache with the eye at the ray origin.
+        let mut e = [FocalTriangle::never(); MAX_LANES];
+        for (slot, c) in e.iter_mut().zip(self.cases) {
+            *slot = FocalTriangle::new(c.origin(), &c.triangle());
+        }
+        let cache = FocalTriangle::<L>::gather(&e[..self.cases.len().min(MAX_LANES)]);
+        let h = triangle::focal::intersect_lanes(&FocalRays::new(&self.ray), &cache, Cull::None);
+        self.hits(h, true);
+    }
 }
 
 fn sphere_list(cases: &[Case]) -> [Sphere; MAX_LANES] {

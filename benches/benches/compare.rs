@@ -103,7 +103,7 @@ fn embree<'a>(
 
 /// Group name of a scene.
 fn group(prim: Prim, kind: Rays, n: usize) -> String {
-    format!("{}/{}/N={n}", prim.name(), kind.name())
+    format!("{}/{}/N={n}", prim.plural(), kind.name())
 }
 
 fn scene(c: &mut Criterion, prim: Prim, kind: Rays, n: usize) {
@@ -327,7 +327,7 @@ fn pivot(recs: &std::collections::BTreeMap<(String, String), Record>) {
                 .collect();
             let mut names: Vec<&String> = recs
                 .iter()
-                .filter(|((g, _), _)| g.starts_with(&format!("{}/{}/", prim.name(), kind.name())))
+                .filter(|((g, _), _)| g.starts_with(&format!("{}/{}/", prim.plural(), kind.name())))
                 .map(|((_, id), _)| id)
                 .collect();
             if names.is_empty() {
@@ -349,7 +349,7 @@ fn pivot(recs: &std::collections::BTreeMap<(String, String), Record>) {
             names.sort_by(|a, b| score(b).total_cmp(&score(a)));
             println!(
                 "**{}, {} rays**: rays/s (× raylane's best in the same scene)\n",
-                prim.name(),
+                prim.plural(),
                 kind.name()
             );
             let mut head = String::from("| contender |");

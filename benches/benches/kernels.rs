@@ -22,13 +22,15 @@ mod common;
 use common::{records, si, timed};
 use criterion::{Criterion, Throughput};
 use raylane::Lane;
-use raylane_bench::{Frame, Kernel, Lanes, Prim, Rays, SIZES, Shape, WIDTHS, cpu, run};
+use raylane_bench::{
+    BenchKernel, Frame, Kernel, Lanes, Prim, Rays, SIZES, Shape, WIDTHS, cpu, run,
+};
 
 /// N of the width and shape table.
 const TABLE_N: usize = 256;
 
 fn group(prim: Prim, kind: Rays, n: usize) -> String {
-    format!("kernels/{}/{}/N={n}", prim.name(), kind.name())
+    format!("kernels/{}/{}/N={n}", prim.plural(), kind.name())
 }
 
 fn id(k: Kernel, w: usize, shape: Shape) -> String {

@@ -23,7 +23,7 @@
 use std::collections::BTreeMap;
 
 use raylane::Lane;
-use raylane_bench::{Frame, Kernel, Lanes, Rays, Shape, frame_ops, with_width};
+use raylane_bench::{BenchKernel, Frame, Kernel, Lanes, Rays, Shape, frame_ops, with_width};
 
 /// Primitives of each kind in the counted scene.
 const N: usize = 64;

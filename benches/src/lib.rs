@@ -4,7 +4,7 @@
 //! * [`scene`]: the generators (no_std; the firmware's instruction counts include the file).
 //! * [`Frame`]: one scene of N primitives of each kind (spheres, triangles, planes, and their
 //!   focal caches) with one set of rays; [`Lanes`] the same data packed for one lane width.
-//! * [`Kernel`], [`Shape`] and [`run`]: every raylane kernel at every width in either packet
+//! * [`Kernel`] (raylane's registry), [`Shape`] and [`run`]: every raylane kernel at every width in either packet
 //!   shape (N rays × 1 primitive: ray packets over a slice; 1 ray × N primitives: one ray over
 //!   primitives packed in lanes), each frame one out-of-line function ([`packets_frame`],
 //!   [`soa_frame`]) so that timings do not depend on how a closure happens to be inlined.
@@ -17,12 +17,10 @@ use std::hint::black_box;
 use glam::Vec3;
 use raylane::hit::Hit;
 use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
-use raylane::sphere::SpherePacket;
-use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
-use raylane::sphere::{self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
+use raylane::sphere::focal::{self as sf, FocalKernel};
+use raylane::sphere::{self, FocalSphere, Sphere, SphereKernel, SpherePacket};
 use raylane::triangle::focal as tf;
-use raylane::triangle::{self, Cramer, Cull, FocalTriangle, Moller, Triangle};
-use raylane::triangle::{TrianglePacket, Watertight};
+use raylane::triangle::{self, Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
 use raylane::{HitRecord, Lane, Mask, Pinhole, Ray, RayPacket};
 
 pub mod parts;
@@ -312,139 +310,37 @@ impl<L: Lane> Lanes<L> {
     }
 }
 
-/// What a kernel intersects.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Prim {
-    /// Spheres.
-    Sphere,
-    /// Triangles.
-    Triangle,
-    /// Planes.
-    Plane,
-}
+pub use raylane::registry::{Kernel, Prim};
 
-impl Prim {
-    /// Lower-case plural name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Prim::Sphere => "spheres",
-            Prim::Triangle => "triangles",
-            Prim::Plane => "planes",
-        }
-    }
-}
-
-/// Every raylane kernel the benchmarks run (triangles two-sided, `Cull::None`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Kernel {
-    /// `sphere::Quadratic`.
-    Quadratic,
-    /// `sphere::QuadraticUnit`.
-    QuadraticUnit,
-    /// `sphere::Geometric`.
-    Geometric,
-    /// `sphere::Robust`.
-    Robust,
-    /// `sphere::focal::Focal` over guarded caches.
-    Focal,
-    /// `sphere::focal::FocalUnguarded` over unguarded caches.
-    FocalUnguarded,
-    /// `plane::closest` / `closest_soa`.
-    Plane,
-    /// `plane::closest_focal` over `FocalPlane` caches.
-    PlaneFocal,
-    /// `triangle::Cramer`.
-    Cramer,
-    /// `triangle::Moller`.
-    Moller,
-    /// `triangle::Watertight`.
-    Watertight,
-    /// `triangle::focal` over `FocalTriangle` caches.
-    TriangleFocal,
-}
-
-impl Kernel {
-    /// Every kernel, spheres first.
-    pub const ALL: [Kernel; 12] = [
-        Kernel::Quadratic,
-        Kernel::QuadraticUnit,
-        Kernel::Geometric,
-        Kernel::Robust,
-        Kernel::Focal,
-        Kernel::FocalUnguarded,
-        Kernel::Plane,
-        Kernel::PlaneFocal,
-        Kernel::Cramer,
-        Kernel::Moller,
-        Kernel::Watertight,
-        Kernel::TriangleFocal,
-    ];
-
-    /// The name (as the op-count table spells it).
-    pub fn name(self) -> &'static str {
-        match self {
-            Kernel::Quadratic => "quadratic",
-            Kernel::QuadraticUnit => "quadratic-unit",
-            Kernel::Geometric => "geometric",
-            Kernel::Robust => "robust",
-            Kernel::Focal => "focal",
-            Kernel::FocalUnguarded => "focal-unguarded",
-            Kernel::Plane => "plane",
-            Kernel::PlaneFocal => "plane-focal",
-            Kernel::Cramer => "cramer",
-            Kernel::Moller => "moller",
-            Kernel::Watertight => "watertight",
-            Kernel::TriangleFocal => "triangle-focal",
-        }
-    }
-
-    /// The kernel called `name`.
-    pub fn from_name(name: &str) -> Option<Kernel> {
-        Kernel::ALL.into_iter().find(|k| k.name() == name)
-    }
-
-    /// What it intersects.
-    pub fn prim(self) -> Prim {
-        match self {
-            Kernel::Quadratic
-            | Kernel::QuadraticUnit
-            | Kernel::Geometric
-            | Kernel::Robust
-            | Kernel::Focal
-            | Kernel::FocalUnguarded => Prim::Sphere,
-            Kernel::Plane | Kernel::PlaneFocal => Prim::Plane,
-            _ => Prim::Triangle,
-        }
-    }
-
-    /// True for the focal caches (coherent rays from the camera's eye only).
-    pub fn focal(self) -> bool {
-        matches!(
-            self,
-            Kernel::Focal | Kernel::FocalUnguarded | Kernel::PlaneFocal | Kernel::TriangleFocal
-        )
-    }
-
+/// What the benchmarks need to know about a kernel of the registry, beyond its metadata.
+pub trait BenchKernel {
     /// True when the kernel can run on `rays` (focal kernels need rays from the eye).
-    pub fn runs_on(self, rays: Rays) -> bool {
-        !self.focal() || rays != Rays::Incoherent
-    }
-
+    fn runs_on(self, rays: Rays) -> bool;
     /// True when the kernel has the 1 ray × N primitives shape (the focal plane has none).
-    pub fn has_soa(self) -> bool {
-        self != Kernel::PlaneFocal
-    }
-
+    fn has_soa(self) -> bool;
     /// Primitive fields the miss path must read per test (the loads of the op-count
     /// minimum): a sphere's centre and radius (4), a focal sphere's `T` and `k_lo` (4), a
     /// plane's point and normal (6), a focal plane's numerator and normal (4), a triangle's
-    /// vertices (9), a focal triangle's three edge normals and their three bounds (12).
-    pub fn miss_loads(self) -> u32 {
+    /// vertices (9; the precomputed methods build their record from them per test here), a
+    /// focal triangle's three edge normals and their three bounds (12).
+    fn miss_loads(self) -> u32;
+}
+
+impl BenchKernel for Kernel {
+    fn runs_on(self, rays: Rays) -> bool {
+        !self.is_focal() || rays != Rays::Incoherent
+    }
+
+    fn has_soa(self) -> bool {
+        self != Kernel::PlaneFocal
+    }
+
+    fn miss_loads(self) -> u32 {
         match self.prim() {
             Prim::Sphere => 4,
-            Prim::Plane if self.focal() => 4,
+            Prim::Plane if self.is_focal() => 4,
             Prim::Plane => 6,
-            Prim::Triangle if self.focal() => 12,
+            Prim::Triangle if self.is_focal() => 12,
             Prim::Triangle => 9,
         }
     }
@@ -498,89 +394,114 @@ pub fn soa_frame<F: Fn(&Ray) -> Option<HitRecord>>(rays: &[Ray], f: F) -> u32 {
     n
 }
 
-/// Dispatches `$body` with `$p` bound to the closest-hit query of kernel `$k` on a ray packet
-/// over `$f`'s primitives (first `$used`), and `$s` to the 1 ray × N query over `$l`.
-macro_rules! with_kernel {
-    ($k:expr, $f:expr, $l:expr, |$p:ident, $s:ident| $body:expr) => {{
-        let (f, l) = ($f, $l);
-        let u = l.used;
-        let none = Cull::None;
-        match $k {
-            Kernel::Quadratic => {
-                let $p = |r: &RayPacket<_>| sphere::closest::<Quadratic, _>(r, &f.spheres[..u]);
-                let $s = |r: &Ray| sphere::closest_soa::<Quadratic, _>(r, &l.spheres);
-                $body
-            }
-            Kernel::QuadraticUnit => {
-                let $p = |r: &RayPacket<_>| sphere::closest::<QuadraticUnit, _>(r, &f.spheres[..u]);
-                let $s = |r: &Ray| sphere::closest_soa::<QuadraticUnit, _>(r, &l.spheres);
-                $body
-            }
-            Kernel::Geometric => {
-                let $p = |r: &RayPacket<_>| sphere::closest::<Geometric, _>(r, &f.spheres[..u]);
-                let $s = |r: &Ray| sphere::closest_soa::<Geometric, _>(r, &l.spheres);
-                $body
-            }
-            Kernel::Robust => {
-                let $p = |r: &RayPacket<_>| sphere::closest::<Robust, _>(r, &f.spheres[..u]);
-                let $s = |r: &Ray| sphere::closest_soa::<Robust, _>(r, &l.spheres);
-                $body
-            }
-            Kernel::Focal => {
-                let $p = |r: &RayPacket<_>| sf::closest::<Focal, _>(r, &f.focal_spheres[..u]);
-                let $s = |r: &Ray| sf::closest_soa::<Focal, _>(r, &l.focal_spheres);
-                $body
-            }
-            Kernel::FocalUnguarded => {
-                let $p = |r: &RayPacket<_>| sf::closest::<FocalUnguarded, _>(r, &f.unguarded[..u]);
-                let $s = |r: &Ray| sf::closest_soa::<FocalUnguarded, _>(r, &l.unguarded);
-                $body
-            }
-            Kernel::Plane => {
-                let $p = |r: &RayPacket<_>| plane::closest(r, &f.planes[..u]);
-                let $s = |r: &Ray| plane::closest_soa(r, &l.planes);
-                $body
-            }
-            Kernel::PlaneFocal => {
-                let $p = |r: &RayPacket<_>| plane::closest_focal(r, &f.focal_planes[..u]);
-                // No 1 ray × N shape: the packet query of the ray splatted (not run).
-                let $s = |r: &Ray| {
-                    plane::closest_focal(&RayPacket::<f32>::splat(r), &f.focal_planes[..u]).lane(0)
-                };
-                $body
-            }
-            Kernel::Cramer => {
-                let $p = |r: &RayPacket<_>| triangle::closest::<Cramer, _>(r, &f.tris[..u], none);
-                let $s = |r: &Ray| triangle::closest_soa::<Cramer, _>(r, &l.tris, none);
-                $body
-            }
-            Kernel::Moller => {
-                let $p = |r: &RayPacket<_>| triangle::closest::<Moller, _>(r, &f.tris[..u], none);
-                let $s = |r: &Ray| triangle::closest_soa::<Moller, _>(r, &l.tris, none);
-                $body
-            }
-            Kernel::Watertight => {
-                let $p =
-                    |r: &RayPacket<_>| triangle::closest::<Watertight, _>(r, &f.tris[..u], none);
-                let $s = |r: &Ray| triangle::closest_soa::<Watertight, _>(r, &l.tris, none);
-                $body
-            }
-            Kernel::TriangleFocal => {
-                let $p = |r: &RayPacket<_>| tf::closest(r, &f.focal_tris[..u], none);
-                let $s = |r: &Ray| tf::closest_soa(r, &l.focal_tris, none);
-                $body
-            }
-        }
-    }};
+/// Code run with one kernel's two queries: `packets`, the closest hit of a ray packet over the
+/// frame's primitives (the first `used`), and `soa`, the closest hit of one ray over the
+/// primitives packed in lanes.
+pub trait WithKernel<L: Lane> {
+    /// What it returns.
+    type Output;
+    /// Runs with the kernel's queries.
+    fn run(
+        self,
+        packets: impl Fn(&RayPacket<L>) -> Hit<L>,
+        soa: impl Fn(&Ray) -> Option<HitRecord>,
+    ) -> Self::Output;
+}
+
+/// The [`raylane::registry::Visitor`] that binds a kernel's queries over a frame and its lanes
+/// and hands them to a [`WithKernel`].
+struct Queries<'a, L: Lane, B> {
+    frame: &'a Frame,
+    lanes: &'a Lanes<L>,
+    body: B,
+}
+
+impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane::registry::Visitor for Queries<'_, L, B> {
+    type Output = B::Output;
+
+    fn sphere<K: SphereKernel>(self, _: Kernel) -> B::Output {
+        let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
+        self.body.run(
+            |r| sphere::closest::<K, _>(r, &f.spheres[..u]),
+            |r| sphere::closest_soa::<K, _>(r, &l.spheres),
+        )
+    }
+
+    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) -> B::Output {
+        let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
+        let (cache, packed) = if guarded {
+            (&f.focal_spheres, &l.focal_spheres)
+        } else {
+            (&f.unguarded, &l.unguarded)
+        };
+        self.body.run(
+            |r| sf::closest::<K, _>(r, &cache[..u]),
+            |r| sf::closest_soa::<K, _>(r, packed),
+        )
+    }
+
+    fn plane(self, _: Kernel) -> B::Output {
+        let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
+        self.body.run(
+            |r| plane::closest(r, &f.planes[..u]),
+            |r| plane::closest_soa(r, &l.planes),
+        )
+    }
+
+    fn focal_plane(self, _: Kernel) -> B::Output {
+        let (f, u) = (self.frame, self.lanes.used);
+        // No 1 ray × N shape: the packet query of the ray splatted (not run).
+        self.body.run(
+            |r| plane::closest_focal(r, &f.focal_planes[..u]),
+            |r| plane::closest_focal(&RayPacket::<f32>::splat(r), &f.focal_planes[..u]).lane(0),
+        )
+    }
+
+    fn triangle<K: TriangleKernel>(self, _: Kernel) -> B::Output {
+        let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
+        self.body.run(
+            |r| triangle::closest::<K, _>(r, &f.tris[..u], Cull::None),
+            |r| triangle::closest_soa::<K, _>(r, &l.tris, Cull::None),
+        )
+    }
+
+    fn focal_triangle(self, _: Kernel) -> B::Output {
+        let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
+        self.body.run(
+            |r| tf::closest(r, &f.focal_tris[..u], Cull::None),
+            |r| tf::closest_soa(r, &l.focal_tris, Cull::None),
+        )
+    }
+}
+
+/// Runs `body` with kernel `k`'s queries over `frame` and `lanes` (built from it).
+pub fn with_kernel<L: Lane<Scalar = f32>, B: WithKernel<L>>(
+    k: Kernel,
+    frame: &Frame,
+    lanes: &Lanes<L>,
+    body: B,
+) -> B::Output {
+    k.visit(Queries { frame, lanes, body })
 }
 
 /// Runs one frame of kernel `k` in shape `shape` over `lanes` (built from `frame`); returns
 /// the number of rays hit.
 pub fn run<L: Lane<Scalar = f32>>(k: Kernel, shape: Shape, frame: &Frame, lanes: &Lanes<L>) -> u32 {
-    with_kernel!(k, frame, lanes, |p, s| match shape {
-        Shape::Packets => packets_frame(&lanes.packets, p),
-        Shape::Soa => soa_frame(&frame.rays, s),
-    })
+    struct Run<'a, L: Lane>(Shape, &'a Frame, &'a Lanes<L>);
+    impl<L: Lane> WithKernel<L> for Run<'_, L> {
+        type Output = u32;
+        fn run(
+            self,
+            p: impl Fn(&RayPacket<L>) -> Hit<L>,
+            s: impl Fn(&Ray) -> Option<HitRecord>,
+        ) -> u32 {
+            match self.0 {
+                Shape::Packets => packets_frame(&self.2.packets, p),
+                Shape::Soa => soa_frame(&self.1.rays, s),
+            }
+        }
+    }
+    with_kernel(k, frame, lanes, Run(shape, frame, lanes))
 }
 
 /// The closest hit of every ray of `frame` with kernel `k` in shape `shape` (for checks).
@@ -590,18 +511,30 @@ pub fn answers<L: Lane<Scalar = f32>>(
     frame: &Frame,
     lanes: &Lanes<L>,
 ) -> Vec<Option<HitRecord>> {
-    with_kernel!(k, frame, lanes, |p, s| match shape {
-        Shape::Packets => lanes
-            .packets
-            .iter()
-            .flat_map(|r| {
-                let h = p(r);
-                (0..L::LANES).map(move |i| h.lane(i))
-            })
-            .take(frame.rays.len())
-            .collect(),
-        Shape::Soa => frame.rays.iter().map(s).collect(),
-    })
+    struct Answers<'a, L: Lane>(Shape, &'a Frame, &'a Lanes<L>);
+    impl<L: Lane<Scalar = f32>> WithKernel<L> for Answers<'_, L> {
+        type Output = Vec<Option<HitRecord>>;
+        fn run(
+            self,
+            p: impl Fn(&RayPacket<L>) -> Hit<L>,
+            s: impl Fn(&Ray) -> Option<HitRecord>,
+        ) -> Self::Output {
+            match self.0 {
+                Shape::Packets => self
+                    .2
+                    .packets
+                    .iter()
+                    .flat_map(|r| {
+                        let h = p(r);
+                        (0..L::LANES).map(move |i| h.lane(i))
+                    })
+                    .take(self.1.rays.len())
+                    .collect(),
+                Shape::Soa => self.1.rays.iter().map(s).collect(),
+            }
+        }
+    }
+    with_kernel(k, frame, lanes, Answers(shape, frame, lanes))
 }
 
 /// The floating-point operations (mul, add, div, sqrt, cmp) of one frame of kernel `k` in the
@@ -611,15 +544,21 @@ pub fn answers<L: Lane<Scalar = f32>>(
 /// work per test the kernel's mathematics needs.)
 pub fn frame_ops(k: Kernel, frame: &Frame, used: usize) -> raylane::opcount::OpCounts {
     use raylane::opcount::{Counted, measure};
-    let lanes = Lanes::<Counted<f32>>::new(frame, used);
-    measure(|| {
-        with_kernel!(k, frame, &lanes, |p, _s| {
-            for r in &lanes.packets {
+    struct Count<'a>(&'a Lanes<Counted<f32>>);
+    impl WithKernel<Counted<f32>> for Count<'_> {
+        type Output = ();
+        fn run(
+            self,
+            p: impl Fn(&RayPacket<Counted<f32>>) -> Hit<Counted<f32>>,
+            _: impl Fn(&Ray) -> Option<HitRecord>,
+        ) {
+            for r in &self.0.packets {
                 black_box(p(r));
             }
-        })
-    })
-    .1
+        }
+    }
+    let lanes = Lanes::<Counted<f32>>::new(frame, used);
+    measure(|| with_kernel(k, frame, &lanes, Count(&lanes))).1
 }
 
 /// Runs `$body` with `$L` bound to the lane type of width `$w` (1, 4, 8 or 16).

@@ -18,10 +18,12 @@
 
 use glam::Vec3;
 
+use super::scene::unit;
 use super::shapes;
-use super::{Camera, Method, Ortho, Paint, Part, Scene, unit};
+use super::{Camera, Ortho, Paint, Part, Scene};
 use crate::camera::Pinhole;
 use crate::plane::Plane;
+use crate::registry::Kernel;
 use crate::sphere::Sphere;
 use crate::triangle::Cull;
 
@@ -53,11 +55,11 @@ impl Precision {
     /// The lecture's distances.
     pub const DISTANCES: [f32; 2] = [100.0, 4100.0];
     /// The methods shown side by side.
-    pub const METHODS: [Method; 4] = [
-        Method::Quadratic,
-        Method::Geometric,
-        Method::Robust,
-        Method::Focal,
+    pub const METHODS: [Kernel; 4] = [
+        Kernel::Quadratic,
+        Kernel::Geometric,
+        Kernel::Robust,
+        Kernel::Focal,
     ];
     /// Centre of the image plane.
     const CENTER: Vec3 = Vec3::new(0.3, 0.2, 0.1);
@@ -118,11 +120,11 @@ impl Ground {
     /// Height of the eye above the ground.
     pub const EYE_HEIGHT: f32 = 1.0;
     /// The methods shown side by side.
-    pub const METHODS: [Method; 4] = [
-        Method::Quadratic,
-        Method::Geometric,
-        Method::Robust,
-        Method::Focal,
+    pub const METHODS: [Kernel; 4] = [
+        Kernel::Quadratic,
+        Kernel::Geometric,
+        Kernel::Robust,
+        Kernel::Focal,
     ];
 
     /// The scene's spheres: the ground first.

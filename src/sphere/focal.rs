@@ -30,8 +30,9 @@
 //! 1e-5 of `t` once `c/r` passes about 5; the sphere of the precision lecture vanishes at 4096.
 //! [`FocalUnguarded`] keeps that textbook form (for comparison and benchmarks).
 //!
-//! **Operation count per lane** (measured): miss 4 mul, 2 add, 1 cmp; hit 10 mul, 10 add,
-//! 1 sqrt, 7 cmp; a doubtful lane adds one `f64` evaluation of [`Robust`].
+//! **Operation count per lane** (measured): `ops focal/miss: 4 mul, 2 add, 1 cmp`;
+//! `ops focal/hit: 10 mul, 10 add, 1 sqrt, 9 cmp`; a doubtful lane adds one `f64` evaluation
+//! of [`Robust`] (`ops focal/doubtful: 27 mul, 27 add, 3 div, 2 sqrt, 16 cmp` in all).
 //!
 //! **Requirements.** Rays start exactly at the eye the cache was built for and have unit
 //! directions (`||U|² − 1| ≤ 2^-20`, which any f32 `normalize` meets; [`Pinhole`] makes such
@@ -134,52 +135,81 @@ impl FocalSphere<f32> {
         ];
         let c2 = te[0] * te[0] + te[1] * te[1] + te[2] * te[2];
         let r = radius as f64;
-        let r2e = r * r;
-        let k = c2 - r2e;
-        let t = V3::new(te[0] as f32, te[1] as f32, te[2] as f32);
-        let r2 = (r2e as f32).max(0.0);
-        let entry = |k_lo: f32, l2_hit: f32, l2_miss: f32, t_acc: f32| FocalSphere {
-            t,
-            k_lo,
-            r2,
-            l2_hit,
-            l2_miss,
-            t_acc,
+        let th = if !(sphere.is_valid() && eye.is_finite()) {
+            Thresholds::NEVER
+        } else if guarded {
+            Thresholds::guarded(c2, r)
+        } else {
+            Thresholds::unguarded(c2, r)
+        };
+        FocalSphere {
+            t: V3::new(te[0] as f32, te[1] as f32, te[2] as f32),
+            k_lo: th.k_lo,
+            r2: ((r * r) as f32).max(0.0),
+            l2_hit: th.l2_hit,
+            l2_miss: th.l2_miss,
+            t_acc: th.t_acc,
             center: center.into(),
             radius,
+        }
+    }
+}
+
+/// The per-entry thresholds of the focal test (see the [module docs](self)).
+struct Thresholds {
+    k_lo: f32,
+    l2_hit: f32,
+    l2_miss: f32,
+    t_acc: f32,
+}
+
+impl Thresholds {
+    /// Bad input: the cheap test rejects every ray.
+    const NEVER: Thresholds = Thresholds {
+        k_lo: f32::INFINITY,
+        l2_hit: f32::NEG_INFINITY,
+        l2_miss: f32::INFINITY,
+        t_acc: f32::INFINITY,
+    };
+
+    /// The lecture's unguarded test: `k_lo = K = c² − r²`.
+    fn unguarded(c2: f64, r: f64) -> Self {
+        // Outside c ≤ 2^30, 2^-30 ≤ r ≤ 2^30 the f32 squares lose their range: never hit.
+        let range = (1.0 / 1_073_741_824.0)..=1_073_741_824.0;
+        let fits = c2 <= sq(*range.end()) && range.contains(&r);
+        let k_lo = if fits {
+            (c2 - r * r) as f32
+        } else {
+            f32::INFINITY
         };
-        if !(sphere.is_valid() && eye.is_finite()) {
-            return entry(
-                f32::INFINITY,
-                f32::NEG_INFINITY,
-                f32::INFINITY,
-                f32::INFINITY,
-            );
+        Thresholds {
+            k_lo,
+            l2_hit: f32::NEG_INFINITY,
+            l2_miss: f32::INFINITY,
+            t_acc: f32::INFINITY,
         }
-        if !guarded {
-            // Outside c ≤ 2^30, 2^-30 ≤ r ≤ 2^30 the f32 squares lose their range: never hit.
-            let range = (1.0 / 1_073_741_824.0)..=1_073_741_824.0;
-            let fits = c2 <= sq(*range.end()) && range.contains(&r);
-            let k_lo = if fits { k as f32 } else { f32::INFINITY };
-            return entry(k_lo, f32::NEG_INFINITY, f32::INFINITY, f32::INFINITY);
-        }
+    }
+
+    /// The guarded test's three steps, from the exact `c²` and `r`.
+    fn guarded(c2: f64, r: f64) -> Self {
+        let r2e = r * r;
         let c = libm::sqrt(c2);
         if !(c <= 1.0e18 && (1.0e-12..=1.0e18).contains(&r)) {
             // Squares would leave f32's range: every ray takes the f64 path (`l2_miss = NaN`
             // so that no lane is a certain miss, not even one whose `l²` overflowed).
-            return entry(
-                f32::NEG_INFINITY,
-                f32::NEG_INFINITY,
-                f32::NAN,
-                f32::INFINITY,
-            );
+            return Thresholds {
+                k_lo: f32::NEG_INFINITY,
+                l2_hit: f32::NEG_INFINITY,
+                l2_miss: f32::NAN,
+                t_acc: f32::INFINITY,
+            };
         }
         let n1 = 1.0 + ETA;
         // Step 1. |v_c − v| ≤ dv (T rounded once, three products, two sums), and the bound E₁ on
         // |fl(v_c²) − |U|²K − disc| that makes v² ≤ K − E₁ a certain miss.
         let dv = 4.02 * U * c * libm::sqrt(n1);
         let e1 = 9.2 * U * c2 * n1 + (ETA + F64_REL) * (c2 + r2e) + ABS;
-        let k_lo = down(k - e1);
+        let k_lo = down((c2 - r2e) - e1);
         // Step 2. p_c = p + αU + w with p ⊥ U, |α| ≤ α_max (dv and the non-unit |U|), |w| ≤ W0 +
         // 2^-24|p_c| (roundings of T, vU and the subtraction). Then |l_c| lies within W of
         // √(l² + α²|U|²), which bounds l from both sides.
@@ -194,12 +224,28 @@ impl FocalSphere<f32> {
         } else {
             -1.0
         };
-        // Step 3. Accuracy of t = v ∓ √(r² − l²) on a certain hit: |t_c − t| ≤ err = rest + E_X/√X,
-        // with rest = α + (2u+η)(c+r) and E_X the error of X = r² − l². Every root of a ray from
-        // outside has |t| ≥ c − r, so aim for err = 0.98·2^-16·|c − r| (at least 2·rest) and accept
-        // only X ≥ X_min = (E_X/(err − rest))² (l² ≤ l2_acc). A root is then within 2^-16 of the
-        // exact one when |t_c| ≥ t_acc = err/2^-16 + err — true for every root of a ray from
-        // outside; one compare per root, per lane, catches the rest.
+        let (l2_acc, t_acc) = Self::accuracy(c, r, alpha, a2, w0);
+        let l2_hit = l2_sure.min(l2_acc);
+        Thresholds {
+            k_lo,
+            l2_hit: if l2_hit >= 0.0 {
+                down(l2_hit)
+            } else {
+                f32::NEG_INFINITY
+            },
+            l2_miss,
+            t_acc,
+        }
+    }
+
+    /// Step 3. Accuracy of t = v ∓ √(r² − l²) on a certain hit: |t_c − t| ≤ err = rest + E_X/√X,
+    /// with rest = α + (2u+η)(c+r) and E_X the error of X = r² − l². Every root of a ray from
+    /// outside has |t| ≥ c − r, so aim for err = 0.98·2^-16·|c − r| (at least 2·rest) and accept
+    /// only X ≥ X_min = (E_X/(err − rest))² (l² ≤ l2_acc). A root is then within 2^-16 of the
+    /// exact one when |t_c| ≥ t_acc = err/2^-16 + err — true for every root of a ray from
+    /// outside; one compare per root, per lane, catches the rest. Returns `(l2_acc, t_acc)`.
+    fn accuracy(c: f64, r: f64, alpha: f64, a2: f64, w0: f64) -> (f64, f32) {
+        let (n1, g3, r2e) = (1.0 + ETA, 3.01 * U, r * r);
         let a = libm::sqrt(a2);
         let wp = w0 + 1.01 * U * (r + a + w0);
         let e_l2 = a2 + 2.0 * wp * (r + a) + wp * wp + g3 * sq(r + a + wp);
@@ -209,18 +255,7 @@ impl FocalSphere<f32> {
         let x_min = sq(e_x / (err - rest));
         let l2_acc = r2e * (1.0 - U) - x_min - e_x;
         let err = err * (1.0 + F64_REL);
-        let t_acc = up(err / EPS_T + err);
-        let l2_hit = l2_sure.min(l2_acc);
-        entry(
-            k_lo,
-            if l2_hit >= 0.0 {
-                down(l2_hit)
-            } else {
-                f32::NEG_INFINITY
-            },
-            l2_miss,
-            t_acc,
-        )
+        (l2_acc, up(err / EPS_T + err))
     }
 }
 
@@ -396,10 +431,11 @@ pub trait FocalKernel {
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Focal;
 
-/// The lecture's unguarded focal test: `v² > K`, `t = v ∓ √(v² − K)`. Miss 4 mul, 2 add,
-/// 1 cmp; hit adds 1 sqrt and 3 add. Misclassifies far small spheres (`c/r` beyond about
-/// 2^11) and loses accuracy in `t` from `c/r ≈ 5`. Build its cache with
-/// [`FocalSphere::unguarded`].
+/// The lecture's unguarded focal test: `v² > K`, `t = v ∓ √(v² − K)`.
+/// `ops focal-unguarded/miss: 4 mul, 2 add, 1 cmp`; a hit adds 1 sqrt, 3 add and the 4
+/// interval compares: `ops focal-unguarded/hit: 4 mul, 5 add, 1 sqrt, 5 cmp`. Misclassifies
+/// far small spheres (`c/r` beyond about 2^11) and loses accuracy in `t` from `c/r ≈ 5`. Build
+/// its cache with [`FocalSphere::unguarded`].
 #[derive(Clone, Copy, Debug, Default)]
 pub struct FocalUnguarded;
 

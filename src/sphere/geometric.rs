@@ -24,8 +24,9 @@ use crate::vec3::V3;
 /// ```
 ///
 /// As a [`SphereKernel`] (one ray, one sphere, nothing cached) it first prepares `T`, `c²`,
-/// `r²` (3 mul + 1 mul, 5 add): miss 8 mul, 8 add, 1 cmp. A hit adds the 4 interval compares
-/// and the 3 of the [range guard](super#range).
+/// `r²` (3 mul + 1 mul, 5 add): `ops geometric/miss: 8 mul, 8 add, 1 cmp`. A hit adds the
+/// half chord, the two roots, the 4 interval compares and the 3 of the
+/// [range guard](super#range): `ops geometric/hit: 8 mul, 11 add, 1 sqrt, 8 cmp`.
 ///
 /// **Range.** `r` within `2^-30…2^30` and `c ≤ 2^30` in f32 (checked on `r²` and `c²`);
 /// outside, [`SphereKernel::roots`] answers in `f64` with [`Robust`](super::Robust), while

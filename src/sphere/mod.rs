@@ -445,7 +445,7 @@ fn precise_normals<L: Lane>(
             ray.dir.precise_lane(i),
             sphere.center.precise_lane(i),
         );
-        let out = o.mul_add(d, t.precise_lane(i)) - c;
+        let out = o.along(d, t.precise_lane(i)) - c;
         let len = out.length_squared().sqrt();
         let zero = <L::Precise as Lane>::from_f32(0.0);
         let n = if (len.gt(zero) & len.is_finite()).any() {
@@ -463,7 +463,8 @@ fn precise_normals<L: Lane>(
     normal
 }
 
-/// Closest hit of one ray and one sphere with kernel `K`: `(t, surface)`, or `None`.
+/// Closest hit of one ray and one sphere with kernel `K`: the [`HitRecord`] of the nearest root
+/// inside the ray's interval (its `t`; `u = v = 0` for spheres), or `None` for a miss.
 #[inline]
 #[must_use]
 pub fn intersect<K: SphereKernel>(ray: &Ray, sphere: &Sphere) -> Option<HitRecord> {

@@ -21,6 +21,7 @@ use crate::ray::RayPacket;
 /// length is a square root, so the discriminant factors as `(r + ℓ)(r − ℓ)` instead of
 /// `r² − ℓ·ℓ`, and the factors 2, 4 and ½ of the textbook quadratic stay (exact multiplies).
 ///
+/// **Claimed count.** None quoted: the study did not search the book's text for one.
 /// **Operation count per lane** (measured by `examples/opcount.rs`, the study table; pinned in
 /// `tests/suite/opcount.rs`): miss 21 mul, 17 add, 1 div, 1 sqrt, 1 cmp; hit 22 mul, 18 add,
 /// 3 div, 2 sqrt, 7 cmp.

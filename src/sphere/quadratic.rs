@@ -15,9 +15,11 @@ use crate::ray::RayPacket;
 /// t = (μ ∓ √δ) / a             when δ ≥ 0
 /// ```
 ///
-/// **Operation count per lane** (measured by `examples/opcount.rs`): miss 12 mul, 11 add,
-/// 1 cmp; hit adds 1 sqrt, 2 add, 2 div, the 4 interval compares and the 5 compares of the
-/// [range guard](super#range) (`QuadraticUnit`: 3).
+/// **Operation count per lane** (measured by `examples/opcount.rs`):
+/// `ops quadratic/miss: 12 mul, 11 add, 1 cmp`; a hit adds 1 sqrt, 2 add, 2 div, the 4
+/// interval compares and the 5 compares of the [range guard](super#range):
+/// `ops quadratic/hit: 12 mul, 13 add, 2 div, 1 sqrt, 10 cmp` (`QuadraticUnit`, with 3:
+/// `ops quadratic-unit/hit: 8 mul, 11 add, 1 sqrt, 8 cmp`).
 ///
 /// **Range.** `|d|`, `r` within `2^-30…2^30` and `|o − c| ≤ 2^30` in f32; lanes outside are
 /// answered by [`Robust`] in `f64` or (below `2^-62`) miss — see [the module](super#range).

@@ -17,7 +17,8 @@ use crate::ray::RayPacket;
 /// t0 = c / q,  t1 = q / a,  c = f·f − r²  (t0·t1 = c/a)
 /// ```
 ///
-/// **Operation count per lane**: miss 14 mul, 13 add, 1 div, 1 cmp; hit adds 3 mul, 4 add,
+/// **Operation count per lane**: `ops robust/miss: 14 mul, 13 add, 1 div, 1 cmp`; a hit
+/// (`ops robust/hit: 17 mul, 17 add, 3 div, 1 sqrt, 12 cmp`) adds 3 mul, 4 add,
 /// 2 div, 1 sqrt, 1 cmp (the sign), 1 cmp (the order: near tangency `c/q` and `q/a` are
 /// rounded separately and used to come back up to 6 ulps out of order at `|f|/r ≥ 2^18`; a
 /// select makes them ascending), the 4 interval compares and the 5 of the
@@ -50,7 +51,7 @@ impl SphereKernel for Robust {
         let a = d.length_squared();
         let beta = -f.dot(d);
         // 2. Perpendicular from the centre to the ray, and the discriminant.
-        let l = f.mul_add(d, beta / a);
+        let l = f.along(d, beta / a);
         let r2 = s.radius * s.radius;
         let disc = a * (r2 - l.length_squared());
         // `!(Δ < 0)`: a NaN or infinite Δ (squares that overflowed) goes on to the range

@@ -26,8 +26,9 @@ use crate::vec3::V3;
 /// weight from the first, `α = (u0 − β·u2)/u1`, with a branch for `u1 = 0`; lanes take the
 /// branch-free 2-D Cramer form instead (one multiply more, no branch).
 ///
-/// **Claimed count.** not quoted: the paper's text was not available to this study (only its
-/// formulation, from secondary sources), so its own tally, if any, is not checked here.
+/// **Claimed count.** None found. The study searched the stored public pages and code for
+/// the Gem's own figures and reached only its citation and one-line summaries (e.g.
+/// Wikipedia's "a fast method"); its tally, if the Gem gives one, is not checked here.
 /// **Measured** per lane (pinned in `tests/suite/opcount.rs`): a triangle behind the origin
 /// (the plane rejects) 6 mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit 14 mul, 17
 /// add, 3 div, 6 cmp; precomputation 9 mul, 11 add, 3 cmp. **Record:** 42 bytes (the plane, 16;

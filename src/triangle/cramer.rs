@@ -24,8 +24,9 @@ use crate::ray::RayPacket;
 /// and tested at once, so the masks narrow and the kernel returns when no lane is left.
 ///
 /// **Operation count per lane** (measured by `examples/opcount.rs`): a miss beyond edge BC
-/// (the latest exit) 21 mul, 22 add, 2 div; one outside `0 ≤ β ≤ 1` exits after 12 mul,
-/// 16 add, 1 div; a hit 30 mul, 27 add, 3 div.
+/// (the latest exit) `ops cramer/miss: 21 mul, 22 add, 2 div, 5 cmp`; one outside
+/// `0 ≤ β ≤ 1` exits after `ops cramer/miss (β): 12 mul, 16 add, 1 div, 3 cmp`; a hit
+/// `ops cramer/hit: 30 mul, 27 add, 3 div, 7 cmp`.
 ///
 /// **Limits.** Not watertight: `β`, `γ` and the sum are rounded independently, so a ray
 /// through a shared edge can slip between two triangles or hit both (see

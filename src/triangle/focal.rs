@@ -81,9 +81,11 @@
 //! own-unit `t` would overflow to `inf` or round to an end (to `0` for `t_min = 0`) is a miss.
 //! `t` is scaled back by `s` once per query (per ray), `u`, `v` need nothing.
 //!
-//! **Operation count per lane** (measured by `examples/opcount.rs`): miss 9 mul, 6 add,
-//! 6 cmp; edges passed but the triangle behind the eye 9 mul, 6 add, 8 cmp; a hit with `t`,
-//! `u`, `v` 13 mul, 10 add, 1 div, 15 cmp (`u`, `v`: 2 div once per ray, for the winner). Per
+//! **Operation count per lane** (measured by `examples/opcount.rs`):
+//! `ops triangle-focal/miss: 9 mul, 6 add, 6 cmp`; edges passed but the triangle behind the eye
+//! `ops triangle-focal/behind: 9 mul, 6 add, 8 cmp`; a hit with `t`, `u`, `v`
+//! `ops triangle-focal/hit: 13 mul, 10 add, 1 div, 15 cmp` (`u`, `v`: 2 div once per ray, for
+//! the winner). Per
 //! ray and query ([`FocalRays::new`]): 3 mul and 2 cmp for the scaling, 6 mul, 2 add, 1 div,
 //! 1 sqrt for the unit direction that bounding spheres use, and 1 mul, 1 add to scale `t`
 //! back (the add turns `−0` into `+0`); the power of two and the interval are found per lane

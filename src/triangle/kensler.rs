@@ -20,8 +20,10 @@ use crate::ray::RayPacket;
 /// A hit needs `u ≥ 0`, `v ≥ 0`, `u + v ≤ 1` (tested first), then `t_min < t < t_max`. Front
 /// faces have `n·d < 0`.
 ///
-/// **Claimed count.** not quoted: the paper's text was not available to this study (only its
-/// formulation, from secondary sources), so its own tally, if any, is not checked here.
+/// **Claimed count.** None found: the study reached the paper's first page only (abstract:
+/// the search's first fitness function "counts operations", the second benchmarks), not the
+/// counts of the test it arrived at. Embree's `triangle_intersector_moeller.h` claims its own
+/// Möller–Trumbore variant "is similar to the fastest one of the paper". Not checked here.
 /// **Measured** per lane (pinned in `tests/suite/opcount.rs`): miss 23 mul, 22 add, 1 div, 3
 /// cmp; hit 27 mul, 24 add, 1 div, 5 cmp.
 ///

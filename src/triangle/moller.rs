@@ -22,9 +22,13 @@ use crate::ray::RayPacket;
 /// one division `t = T/|det|`, and `u = U/|det|`, `v = V/|det|` once per ray for the winner
 /// (see [`triangle`](super) on deferred division).
 ///
-/// **Operation count per lane** (measured by `examples/opcount.rs`): miss 21 mul, 22 add,
-/// 5 cmp; a triangle behind the origin 24 mul, 24 add (no division); hit 25 mul, 24 add,
-/// 1 div, 12 cmp.
+/// **Claimed count.** None found: the paper's abstract (the part the study reached) claims
+/// storage and speed, not operations: "the plane equation need not be computed on the fly nor
+/// be stored" and, "comparable in speed to previous methods", "the fastest ray/triangle
+/// intersection routine for triangles which do not have precomputed plane equations".
+/// **Operation count per lane** (measured by `examples/opcount.rs`):
+/// `ops moller/miss: 21 mul, 22 add, 5 cmp`; a triangle behind the origin (no division)
+/// `ops moller/behind: 24 mul, 24 add, 7 cmp`; `ops moller/hit: 25 mul, 24 add, 1 div, 12 cmp`.
 ///
 /// **Limits.** Not watertight: the edge values of two triangles sharing an edge are computed
 /// from different origins (`s = o − A` differs), so a ray through the edge can slip between

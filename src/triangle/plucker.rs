@@ -38,8 +38,10 @@ use crate::ray::RayPacket;
 /// without the widening `ε` they can all exclude the ray: exact compares leaked 4 of the
 /// 10,950 rays of `tests/suite/watertight.rs`; with `ε` the counts are in the study table.
 ///
-/// **Claimed count.** Embree's source states none (read for this study); measured here per lane (pinned in
-/// `tests/suite/opcount.rs`): miss 28 mul, 44 add, 6 cmp; hit 41 mul, 53 add, 1 div, 20 cmp.
+/// **Claimed count.** None found. Embree's source states none (read for this study); the
+/// study did not reach Segura and Feito's text (only its citation), so a tally there, if any,
+/// is not checked. **Measured** per lane (pinned in `tests/suite/opcount.rs`): miss 28 mul,
+/// 44 add, 6 cmp; hit 41 mul, 53 add, 1 div, 20 cmp.
 ///
 /// **Edge cases.** `den = 0` or `U + V + W = 0` is a miss; NaN fails every compare.
 #[derive(Clone, Copy, Debug, Default)]

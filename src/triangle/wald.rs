@@ -25,8 +25,9 @@ use crate::ray::RayPacket;
 /// `u + v ≤ 1`, each exit as early as the thesis takes it. The division is a reciprocal and a
 /// multiply, as in the thesis.
 ///
-/// **Claimed count.** not quoted: the paper's text was not available to this study (only its
-/// formulation, from secondary sources), so its own tally, if any, is not checked here.
+/// **Claimed count.** None found. The study searched the stored public pages and code for the
+/// thesis' figures for this test and reached implementations of the `TriAccel` record, not
+/// the thesis' text; its tally, if any, is not checked here.
 /// **Measured** per lane (pinned in `tests/suite/opcount.rs`): a triangle behind the origin 5
 /// mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit 11 mul, 12 add, 1 div, 5 cmp;
 /// precomputation 20 mul, 13 add, 1 div, 4 cmp. **Record:** 37 bytes (nine floats and the axis

@@ -29,9 +29,12 @@ use crate::vec3::V3;
 /// vertex. Edges count as inside from both sides: no ray slips through a closed mesh, and a
 /// ray through a shared edge or vertex may be reported by each triangle that owns it.
 ///
-/// **Operation count per lane** (measured by `examples/opcount.rs`): per ray 3 div, 4 cmp
-/// ([`Shear::new`]); per triangle a miss 12 mul, 18 add, 6 cmp; a hit 19 mul, 22 add, 1 div,
-/// 15 cmp; a lane with an exactly zero edge function adds 6 mul and 3 add in `f64`.
+/// **Operation count per lane** (measured by `examples/opcount.rs`): per ray
+/// `ops watertight/per ray: 3 div, 4 cmp` ([`Shear::new`]); per triangle
+/// `ops watertight/miss: 12 mul, 18 add, 6 cmp`,
+/// `ops watertight/hit: 19 mul, 22 add, 1 div, 15 cmp`; a lane with an exactly zero edge
+/// function adds 6 mul and 3 add in `f64`
+/// (`ops watertight/zero edge: 25 mul, 25 add, 1 div, 21 cmp`).
 ///
 /// **Edge cases.** `det = 0` (a ray parallel to the triangle, or a degenerate projection) is a
 /// miss; NaN fails the compares; a zero direction never reaches the kernel (rays are

@@ -4,8 +4,8 @@
 //!   for Cortex-M (cortex-m-rt, cortex-m-semihosting) and RISC-V (riscv-rt,
 //!   riscv-semihosting), and [`panic_exits!`], a panic handler that prints and fails;
 //! * [`Cases`], the test vectors as `build.rs` encodes them;
-//! * [`every_kernel`], which calls every kernel of raylane at one lane width (every
-//!   formulation and entry point), with inputs from volatile reads and results to a volatile
+//! * [`every_kernel`], which calls every kernel of raylane's registry at one lane width (and
+//!   every other entry point), with inputs from volatile reads and results to a volatile
 //!   sink so nothing is folded away.
 #![no_std]
 
@@ -15,14 +15,12 @@ use glam::Vec3;
 use raylane::hit::Hit;
 use raylane::mesh::Mesh;
 use raylane::plane::{self, FocalPlane, Plane};
-use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
-use raylane::sphere::{
-    self, EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust, Sphere,
-    SpherePacket,
-};
+use raylane::registry::{Kernel, Visitor};
+use raylane::sphere::focal::{self as sf, Focal, FocalKernel};
+use raylane::sphere::{self, FocalSphere, Robust, Sphere, SphereKernel, SpherePacket};
 use raylane::triangle::{
-    self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout,
-    KenslerShirley, Moller, Plucker, Triangle, TrianglePacket, Wald, Watertight,
+    self, Cull, FocalRays, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket,
+    Watertight,
 };
 use raylane::vectors::{Case, Kind, Values};
 use raylane::{Lane, Mask, Ray, RayPacket};
@@ -157,69 +155,85 @@ fn rec(r: Option<raylane::HitRecord>) {
     sink(r.map_or(7, |h| h.t.to_bits() ^ h.index));
 }
 
+/// One call of each kernel of raylane's registry: its closest-hit query of `rays` over a few
+/// primitives (caches built with the eye at `eye`).
+struct Closest<'a, L: Lane> {
+    rays: &'a RayPacket<L>,
+    eye: Vec3,
+    balls: &'a [Sphere; 3],
+    walls: &'a [Plane; 2],
+    tris: &'a [Triangle; 2],
+}
+
+impl<L: Lane<Scalar = f32>> Visitor for Closest<'_, L> {
+    type Output = ();
+    fn sphere<K: SphereKernel>(self, _: Kernel) {
+        hits(&sphere::closest::<K, L>(self.rays, self.balls));
+    }
+    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) {
+        let mut cache = [FocalSphere::new(self.eye, &self.balls[0]); 3];
+        for (slot, s) in cache.iter_mut().zip(self.balls) {
+            *slot = if guarded {
+                FocalSphere::new(self.eye, s)
+            } else {
+                FocalSphere::unguarded(self.eye, s)
+            };
+        }
+        hits(&sf::closest::<K, L>(self.rays, &cache));
+    }
+    fn plane(self, _: Kernel) {
+        hits(&plane::closest::<L>(self.rays, self.walls));
+    }
+    fn focal_plane(self, _: Kernel) {
+        let cache = [FocalPlane::new(self.eye, &self.walls[0])];
+        hits(&plane::closest_focal::<L>(self.rays, &cache));
+    }
+    fn triangle<K: TriangleKernel>(self, _: Kernel) {
+        hits(&triangle::closest::<K, L>(self.rays, self.tris, Cull::None));
+    }
+    fn focal_triangle(self, _: Kernel) {
+        let mut cache = [FocalTriangle::never(); 2];
+        triangle::focal::focus(self.eye, self.tris, &mut cache);
+        hits(&triangle::focal::closest(self.rays, &cache, Cull::None));
+    }
+}
+
 pub fn every_kernel<L: Lane<Scalar = f32>>(rays: &RayPacket<L>, ray: &Ray) {
     let balls = [
         Sphere::new(v(5), x(6)),
         Sphere::new(v(0), x(4)),
         Sphere::new(v(8), x(9)),
     ];
+    let walls = [Plane::new(v(3), v(7)), Plane::new(v(1), v(2))];
+    let tris = [
+        Triangle::new(v(0), v(3), v(6)),
+        Triangle::new(v(2), v(9), v(12)),
+    ];
     let eye = ray.origin();
-    // Spheres: every formulation, N rays × 1 sphere and 1 ray × N spheres.
-    hits(&sphere::closest::<Quadratic, L>(rays, &balls));
-    hits(&sphere::closest::<QuadraticUnit, L>(rays, &balls));
-    hits(&sphere::closest::<Geometric, L>(rays, &balls));
-    hits(&sphere::closest::<Robust, L>(rays, &balls));
-    hits(&sphere::closest::<Pbrt, L>(rays, &balls));
-    hits(&sphere::closest::<EmbreeSphere, L>(rays, &balls));
+    // Every kernel of the registry: N rays × its primitives.
+    for k in Kernel::ALL {
+        k.visit(Closest {
+            rays,
+            eye,
+            balls: &balls,
+            walls: &walls,
+            tris: &tris,
+        });
+    }
+    // The other entry points: 1 ray × N primitives in lanes, any, all, one ray, meshes.
     sink(sphere::any::<Robust, L>(rays, &balls).bits());
     sphere::all::<Robust, L>(rays, &balls, |i, r| sink(i ^ r.any().bits()));
     let mut packed = [SpherePacket::<L>::from_spheres(&[]); 1];
     SpherePacket::pack(&balls, &mut packed);
     rec(sphere::closest_soa::<Robust, L>(ray, &packed));
     rec(sphere::intersect::<Robust>(ray, &balls[0]));
-    // Focal spheres, guarded and not.
     let mut cache = [FocalSphere::new(eye, &balls[0]); 3];
     sf::focus(eye, &balls, &mut cache);
-    hits(&sf::closest::<Focal, L>(rays, &cache));
     sink(sf::any::<Focal, L>(rays, &cache).bits());
-    let unguarded = [FocalSphere::unguarded(eye, &balls[1])];
-    hits(&sf::closest::<FocalUnguarded, L>(rays, &unguarded));
     let mut fpacked = [FocalSphere::<L>::gather(&[]); 1];
     FocalSphere::pack(&cache, &mut fpacked);
     rec(sf::closest_soa::<Focal, L>(ray, &fpacked));
-    // Planes.
-    let walls = [Plane::new(v(3), v(7)), Plane::new(v(1), v(2))];
-    hits(&plane::closest::<L>(rays, &walls));
-    hits(&plane::closest_focal::<L>(
-        rays,
-        &[FocalPlane::new(eye, &walls[0])],
-    ));
-    // Triangles: every formulation, packets of rays and of triangles, meshes and caches.
-    let tris = [
-        Triangle::new(v(0), v(3), v(6)),
-        Triangle::new(v(2), v(9), v(12)),
-    ];
-    hits(&triangle::closest::<Cramer, L>(rays, &tris, Cull::None));
     hits(&triangle::closest::<Moller, L>(rays, &tris, Cull::Back));
-    hits(&triangle::closest::<Watertight, L>(rays, &tris, Cull::None));
-    hits(&triangle::closest::<Badouel, L>(rays, &tris, Cull::None));
-    hits(&triangle::closest::<Plucker, L>(rays, &tris, Cull::None));
-    hits(&triangle::closest::<Wald, L>(rays, &tris, Cull::None));
-    hits(&triangle::closest::<HavelHerout, L>(
-        rays,
-        &tris,
-        Cull::None,
-    ));
-    hits(&triangle::closest::<KenslerShirley, L>(
-        rays,
-        &tris,
-        Cull::None,
-    ));
-    hits(&triangle::closest::<BaldwinWeber, L>(
-        rays,
-        &tris,
-        Cull::None,
-    ));
     sink(triangle::any::<Watertight, L>(rays, &tris, Cull::None).bits());
     triangle::all::<Moller, L>(rays, &tris, Cull::None, |i, h| sink(i ^ h.mask.bits()));
     let mut tpacked = [TrianglePacket::<L>::from_triangles(&[]); 1];
@@ -231,7 +245,6 @@ pub fn every_kernel<L: Lane<Scalar = f32>>(rays: &RayPacket<L>, ray: &Ray) {
     ));
     let mut tcache = [FocalTriangle::never(); 2];
     triangle::focal::focus(eye, &tris, &mut tcache);
-    hits(&triangle::focal::closest(rays, &tcache, Cull::None));
     sink(triangle::focal::any(rays, &tcache, Cull::None).bits());
     let positions = [v(0), v(3), v(6), v(9)];
     let indices = [[0u32, 1, 2], [1, 3, 2], [0, 3, 9]];

@@ -3,11 +3,14 @@
 
 use glam::Vec3;
 use raylane::plane::{self, FocalPlane, Plane};
-use raylane::sphere::focal::{self, Focal, FocalUnguarded};
+use raylane::registry::{Kernel, Prim, Visitor};
+use raylane::sphere::focal::FocalKernel;
+use raylane::sphere::focal::{self, Focal};
 use raylane::sphere::{
-    self, EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust, Sphere,
-    SphereKernel, SpherePacket,
+    self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere, SphereKernel,
+    SpherePacket,
 };
+use raylane::triangle::TriangleKernel;
 use raylane::{Lane, Ray, RayPacket};
 use wide::f32x8;
 
@@ -66,27 +69,49 @@ fn misses<K: SphereKernel>(ray: &Ray, s: &Sphere, what: &str) {
     assert_eq!(sphere::intersect::<K>(ray, s), None);
 }
 
+fn focal_misses<K: FocalKernel>(ray: &Ray, s: &Sphere, guarded: bool, what: &str) {
+    let e = if guarded {
+        FocalSphere::new(ray.origin(), s)
+    } else {
+        FocalSphere::unguarded(ray.origin(), s)
+    };
+    let r = K::roots(&RayPacket::<f32>::splat(ray), &FocalSphere::splat(&e));
+    assert!(
+        !r.m0 && !r.m1 && r.t0 == INF && r.t1 == INF,
+        "{} {what}",
+        K::NAME
+    );
+}
+
+/// [`misses`] or [`focal_misses`] for a registry kernel.
+struct Misses<'a>(&'a Ray, &'a Sphere, &'a str);
+
+impl Visitor for Misses<'_> {
+    type Output = ();
+    fn sphere<K: SphereKernel>(self, _: Kernel) {
+        misses::<K>(self.0, self.1, self.2);
+    }
+    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) {
+        focal_misses::<K>(self.0, self.1, guarded, self.2);
+    }
+    fn plane(self, k: Kernel) {
+        unreachable!("{} is not a sphere kernel", k.name())
+    }
+    fn focal_plane(self, k: Kernel) {
+        unreachable!("{} is not a sphere kernel", k.name())
+    }
+    fn triangle<K: TriangleKernel>(self, k: Kernel) {
+        unreachable!("{} is not a sphere kernel", k.name())
+    }
+    fn focal_triangle(self, k: Kernel) {
+        unreachable!("{} is not a sphere kernel", k.name())
+    }
+}
+
+/// Every sphere kernel of the registry misses.
 fn every_kernel_misses(ray: &Ray, s: &Sphere, what: &str) {
-    misses::<Quadratic>(ray, s, what);
-    misses::<QuadraticUnit>(ray, s, what);
-    misses::<Geometric>(ray, s, what);
-    misses::<Robust>(ray, s, what);
-    misses::<Pbrt>(ray, s, what);
-    misses::<EmbreeSphere>(ray, s, what);
-    for (name, e) in [
-        ("focal", FocalSphere::new(ray.origin(), s)),
-        ("unguarded", FocalSphere::unguarded(ray.origin(), s)),
-    ] {
-        let rp = RayPacket::<f32>::splat(ray);
-        let r = if name == "focal" {
-            <Focal as focal::FocalKernel>::roots(&rp, &FocalSphere::splat(&e))
-        } else {
-            <FocalUnguarded as focal::FocalKernel>::roots(&rp, &FocalSphere::splat(&e))
-        };
-        assert!(
-            !r.m0 && !r.m1 && r.t0 == INF && r.t1 == INF,
-            "{name} {what}"
-        );
+    for k in Kernel::of(Prim::Sphere) {
+        k.visit(Misses(ray, s, what));
     }
 }
 

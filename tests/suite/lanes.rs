@@ -7,12 +7,12 @@ use rand::{Rng, SeedableRng};
 use raylane::hit::Hit;
 use raylane::lane::{Lane, Mask};
 use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
-use raylane::sphere::focal::{self, Focal, FocalKernel, FocalUnguarded};
-use raylane::sphere::{
-    self, EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust, Roots,
-    Sphere, SphereKernel, SpherePacket,
-};
+use raylane::registry::{Kernel, Prim, Visitor};
+use raylane::sphere::focal::{self, Focal, FocalKernel};
+use raylane::sphere::{self, FocalSphere, Robust, Roots, Sphere, SphereKernel, SpherePacket};
+use raylane::triangle::TriangleKernel;
 use raylane::{Ray, RayPacket, V3};
+use std::marker::PhantomData;
 use wide::{f32x4, f32x8, f32x16};
 
 const BATCHES: usize = 400;
@@ -156,19 +156,40 @@ fn every_kernel<L: Lane<Scalar = f32>>(seed: u64) {
         } else {
             L::LANES
         };
-        kernel::<Quadratic, L>(&rays[..n], &spheres);
-        kernel::<QuadraticUnit, L>(&rays[..n], &spheres);
-        kernel::<Geometric, L>(&rays[..n], &spheres);
-        kernel::<Robust, L>(&rays[..n], &spheres);
-        kernel::<Pbrt, L>(&rays[..n], &spheres);
-        kernel::<EmbreeSphere, L>(&rays[..n], &spheres);
-        focal_kernel::<Focal, L>(&rays[..n], &spheres, true);
-        focal_kernel::<FocalUnguarded, L>(&rays[..n], &spheres, false);
+        // Every sphere kernel of the registry.
+        for k in Kernel::of(Prim::Sphere) {
+            k.visit(Lanes::<L>(&rays[..n], &spheres, PhantomData));
+        }
         let ps: Vec<Plane> = spheres
             .iter()
             .map(|s| Plane::new(s.center(), vec(&mut rng, 1.0)))
             .collect();
         planes::<L>(&rays, &ps);
+    }
+}
+
+/// [`kernel`] or [`focal_kernel`] for a registry kernel.
+struct Lanes<'a, L>(&'a [Ray], &'a [Sphere], PhantomData<L>);
+
+impl<L: Lane<Scalar = f32>> Visitor for Lanes<'_, L> {
+    type Output = ();
+    fn sphere<K: SphereKernel>(self, _: Kernel) {
+        kernel::<K, L>(self.0, self.1);
+    }
+    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) {
+        focal_kernel::<K, L>(self.0, self.1, guarded);
+    }
+    fn plane(self, k: Kernel) {
+        unreachable!("{} is not a sphere kernel", k.name())
+    }
+    fn focal_plane(self, k: Kernel) {
+        unreachable!("{} is not a sphere kernel", k.name())
+    }
+    fn triangle<K: TriangleKernel>(self, k: Kernel) {
+        unreachable!("{} is not a sphere kernel", k.name())
+    }
+    fn focal_triangle(self, k: Kernel) {
+        unreachable!("{} is not a sphere kernel", k.name())
     }
 }
 

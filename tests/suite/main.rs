@@ -6,6 +6,7 @@ mod accuracy;
 mod bad_input;
 mod bunny;
 mod bvh;
+mod doc_counts;
 mod exact_ref;
 mod focal_accuracy;
 mod focal_precision;

@@ -199,3 +199,25 @@ fn published_methods_counts_are_pinned() {
     let wald = get("wald", tri);
     assert!(wald.behind.unwrap().flops() < focal.behind.unwrap().flops());
 }
+
+#[test]
+fn every_registry_kernel_is_in_the_report() {
+    use raylane::registry::Kernel;
+    let t = table();
+    assert!(
+        t.len() < raylane::opcount::MAX_ROWS,
+        "the report may be truncated"
+    );
+    for k in Kernel::ALL {
+        assert!(
+            t.iter().any(|r| r.kernel == k.name() && r.path == "miss"),
+            "{} has no miss row",
+            k.name()
+        );
+        assert!(
+            t.iter().any(|r| r.kernel == k.name() && r.path == "hit"),
+            "{} has no hit row",
+            k.name()
+        );
+    }
+}

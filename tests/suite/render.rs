@@ -14,11 +14,12 @@
 
 use glam::Vec3;
 use raylane::demo::{
-    self, Camera, Frame, ID_NONE, ID_SPHERE, ID_TRIANGLE, Method, Part, Scene, Storage,
+    self, Camera, Frame, ID_NONE, ID_SPHERE, ID_TRIANGLE, Part, Scene, Storage,
     scenes::{self, Ground, Mix, Precision},
     shapes,
 };
 use raylane::plane::FocalPlane;
+use raylane::registry::Kernel;
 use raylane::sphere::FocalSphere;
 use raylane::triangle::{Cull, FocalTriangle};
 use raylane::{Lane, RayPacket, V3};
@@ -133,7 +134,7 @@ fn precision_sphere_pixels_per_method() {
         let p = Precision::new(d);
         let cam = Precision::camera(size, size);
         let center = p.scene().spheres[0].center();
-        for m in Method::ALL {
+        for m in demo::sphere_kernels() {
             let f = Frame::new(p.scene(), cam, m, Storage::none()).unwrap();
             let (_, ids) = render(&f);
             let hits = ids.iter().filter(|&&i| i == ID_SPHERE).count();
@@ -156,8 +157,8 @@ fn precision_sphere_pixels_per_method() {
             counts.push((d, m, hits, wrong));
         }
     }
-    let get = |d: f32, m: Method| counts.iter().find(|c| c.0 == d && c.1 == m).unwrap();
-    for m in Method::ALL {
+    let get = |d: f32, m: Kernel| counts.iter().find(|c| c.0 == d && c.1 == m).unwrap();
+    for m in demo::sphere_kernels() {
         let near = get(100.0, m);
         assert!(
             near.2 > 700 && near.3 == 0,
@@ -166,23 +167,32 @@ fn precision_sphere_pixels_per_method() {
             near
         );
     }
-    for m in [Method::Robust, Method::Focal] {
+    for m in [
+        Kernel::Robust,
+        Kernel::Focal,
+        Kernel::Pbrt,
+        Kernel::EmbreeSphere,
+    ] {
         let far = get(4100.0, m);
         assert!(far.2 > 700, "{} lost the sphere at 4100 units", m.name());
         assert_eq!(far.3, 0, "{} misclassified pixels at 4100 units", m.name());
     }
     // Every count at 4100 units, pinned as rendered: the textbook methods lose the sphere in
     // noise (quadratic and geometric hit far beyond the disc, the unguarded focal test loses
-    // half of it), robust and focal draw the disc of 100 units.
-    let pinned: [(Method, usize); 6] = [
-        (Method::Quadratic, 2528),
-        (Method::QuadraticUnit, 2528),
-        (Method::Geometric, 1340),
-        (Method::Robust, 812),
-        (Method::Focal, 812),
-        (Method::FocalUnguarded, 374),
+    // half of it), robust, focal, pbrt and embree draw the disc of 100 units.
+    let pinned: [(Kernel, usize); 8] = [
+        (Kernel::Quadratic, 2528),
+        (Kernel::QuadraticUnit, 2528),
+        (Kernel::Geometric, 1340),
+        (Kernel::Robust, 812),
+        (Kernel::Focal, 812),
+        (Kernel::FocalUnguarded, 374),
+        (Kernel::Pbrt, 812),
+        (Kernel::EmbreeSphere, 812),
     ];
-    let got: Vec<(Method, usize)> = Method::ALL.iter().map(|&m| (m, get(4100.0, m).2)).collect();
+    let got: Vec<(Kernel, usize)> = demo::sphere_kernels()
+        .map(|m| (m, get(4100.0, m).2))
+        .collect();
     assert_eq!(got, pinned, "sphere pixels at 4100 units changed");
 }
 
@@ -280,7 +290,7 @@ fn icosphere_render_has_no_cracks() {
     let (width, height) = (160, 120);
     let cam = scenes::icosphere_camera(width, height);
     let mut store = Store::new(&scene);
-    let f = Frame::new(scene, cam, Method::Focal, store.storage()).unwrap();
+    let f = Frame::new(scene, cam, Kernel::Focal, store.storage()).unwrap();
     let (_, ids) = render_with::<f32x16>(&f);
     let (mut inside, mut cracks, mut stray) = (0, 0, 0);
     for y in 0..height {
@@ -311,7 +321,7 @@ fn icosphere_render_has_no_cracks() {
     // Every lane width gives the same picture (a smaller copy, to keep the test quick).
     let cam = scenes::icosphere_camera(48, 32);
     let mut store = Store::new(&scene);
-    render(&Frame::new(scene, cam, Method::Focal, store.storage()).unwrap());
+    render(&Frame::new(scene, cam, Kernel::Focal, store.storage()).unwrap());
 }
 
 #[test]
@@ -352,7 +362,7 @@ fn image_digests_are_pinned() {
     let f = Frame::new(
         scene,
         scenes::icosphere_camera(40, 30),
-        Method::Focal,
+        Kernel::Focal,
         store.storage(),
     )
     .unwrap();
@@ -361,7 +371,7 @@ fn image_digests_are_pinned() {
     let m = Mix::new();
     let (w, h) = Mix::FIRMWARE_SIZE;
     let mut store = Store::new(&m.scene());
-    let f = Frame::new(m.scene(), Mix::camera(w, h), Method::Focal, store.storage()).unwrap();
+    let f = Frame::new(m.scene(), Mix::camera(w, h), Kernel::Focal, store.storage()).unwrap();
     got.push(("mix 64x48", demo::fnv1a(&render(&f).0)));
     for (name, d) in &got {
         println!("{name:<22} {d:#018x}");
@@ -382,21 +392,21 @@ fn frames_refuse_short_storage_and_render_into_short_buffers() {
     let mut store = Store::new(&m.scene());
     store.triangles.truncate(Mix::TRIANGLES - 1);
     assert_eq!(
-        Frame::new(m.scene(), cam, Method::Focal, store.storage()).err(),
+        Frame::new(m.scene(), cam, Kernel::Focal, store.storage()).err(),
         Some(demo::SetupError::TriangleStorage)
     );
     let mut store = Store::new(&m.scene());
     store.spheres.clear();
     assert_eq!(
-        Frame::new(m.scene(), cam, Method::Focal, store.storage()).err(),
+        Frame::new(m.scene(), cam, Kernel::Focal, store.storage()).err(),
         Some(demo::SetupError::SphereStorage)
     );
     // Non-focal methods need no sphere entries.
-    let f = Frame::new(m.scene(), cam, Method::Robust, store.storage());
+    let f = Frame::new(m.scene(), cam, Kernel::Robust, store.storage());
     assert!(f.is_ok());
     // A buffer too short for the image: the whole pixels that fit are written, no panic.
     let mut store = Store::new(&m.scene());
-    let f = Frame::new(m.scene(), cam, Method::Focal, store.storage()).unwrap();
+    let f = Frame::new(m.scene(), cam, Kernel::Focal, store.storage()).unwrap();
     let mut short = vec![0u8; 3 * 16 * 8 - 5];
     let stats = f.render::<f32x8>(&mut short, None);
     assert_eq!(stats.rays, 16 * 8);

@@ -4,7 +4,7 @@
 //! of the watertight harness. `examples/opcount.rs` includes this file to print the table;
 //! the test pins the README's copy.
 
-use raylane::study::{self, Entry, Measured, Shape};
+use raylane::study::{self, Entry, Insns, Measured, Shape};
 use raylane::vectors::accuracy::{self, CLASSES};
 use raylane::vectors::{Case, Kind, Method, Outcome};
 
@@ -15,8 +15,48 @@ pub const BEGIN: &str = "<!-- opstudy:begin -->\n";
 /// The end marker.
 pub const END: &str = "<!-- opstudy:end -->";
 
+/// The instruction counts `scripts/count-study.sh` measured: `(target, shape, method, path)`
+/// to instructions per test.
+fn insns() -> Vec<(String, String, String, String, f64)> {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/study-insns.txt");
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("{path}: {e}"));
+    text.lines()
+        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
+        .map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            assert_eq!(
+                w.len(),
+                5,
+                "{path}: `target shape method path insns`, got {l:?}"
+            );
+            let n = w[4]
+                .parse()
+                .unwrap_or_else(|e| panic!("{path}: {l:?}: {e}"));
+            (w[0].into(), w[1].into(), w[2].into(), w[3].into(), n)
+        })
+        .collect()
+}
+
 /// The table, measured now.
 pub fn report() -> String {
+    let insns = insns();
+    let lookup = |target: &str, e: &Entry| -> Option<Insns> {
+        let shape = match e.shape {
+            Shape::Triangle => "triangle",
+            Shape::Sphere => "sphere",
+        };
+        let get = |path: &str| {
+            insns
+                .iter()
+                .find(|r| r.0 == target && r.1 == shape && r.2 == e.method && r.3 == path)
+                .map(|r| r.4)
+        };
+        Some(Insns {
+            miss: get("miss")?,
+            hit: get("hit")?,
+            precompute: get("precompute"),
+        })
+    };
     let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/vectors");
     let texts: Vec<String> = CLASSES
         .iter()
@@ -32,7 +72,7 @@ pub fn report() -> String {
             Shape::Triangle => Kind::Triangle,
             Shape::Sphere => Kind::Sphere,
         };
-        let method = Method::parse(e.method).expect("every study method is in the checker");
+        let method = Method::from_name(e.method).expect("every study method is in the checker");
         let mut m = Measured::default();
         let classes = CLASSES.iter().enumerate().filter(|(_, c)| c.kind == kind);
         for (slot, (k, c)) in m.accuracy.iter_mut().zip(classes) {
@@ -40,13 +80,14 @@ pub fn report() -> String {
                 .unwrap_or_else(|| panic!("{}: cannot be evaluated", c.file));
             *slot = Some((errors.t, errors.wrong));
         }
-        m.watertight = watertight::Method::ALL
-            .into_iter()
-            .find(|w| kind == Kind::Triangle && w.name() == e.method)
+        m.watertight = watertight::methods()
+            .find(|w| kind == Kind::Triangle && w.method().name() == e.method)
             .map(|w| {
                 let t = watertight::totals(w);
                 (t.rays, t.leaks, t.doubles)
             });
+        m.x86 = lookup("x86-64-v3", e);
+        m.m4f = lookup("cortex-m4f", e);
         m
     };
     let mut table = String::new();
@@ -77,4 +118,61 @@ fn readme_study_table_is_the_report() {
         report(),
         "regenerate the README's study table with `cargo run --example opcount -- --write`"
     );
+}
+
+#[test]
+fn the_timed_methods_are_the_entries() {
+    let names: Vec<_> = study::entries()
+        .iter()
+        .map(|e| (e.shape, e.method))
+        .collect();
+    assert_eq!(names, study::METHODS);
+}
+
+#[test]
+fn the_timed_loops_hit_and_miss_as_announced() {
+    use raylane::study::{METHODS, Path, Precompute, entries, precomputes, repeat, units};
+    use wide::f32x8;
+    let entries = entries();
+    for (i, m) in METHODS.iter().enumerate() {
+        assert_eq!(repeat::<f32>(i, Path::Miss, 3), Some(0), "{m:?}");
+        assert_eq!(repeat::<f32>(i, Path::Hit, 3), Some(3), "{m:?}");
+        assert_eq!(repeat::<f32x8>(i, Path::Hit, 2), Some(16), "{m:?}");
+        assert_eq!(precomputes(i), entries[i].pre != Precompute::None, "{m:?}");
+        let built = if precomputes(i) {
+            2 * units::<f32x8>(i, Path::Precompute)
+        } else {
+            0
+        };
+        assert_eq!(
+            repeat::<f32x8>(i, Path::Precompute, 2),
+            Some(built as u32),
+            "{m:?}"
+        );
+    }
+    assert_eq!(repeat::<f32>(METHODS.len(), Path::Hit, 1), None);
+}
+
+#[test]
+fn every_method_has_its_instruction_counts() {
+    let insns = insns();
+    for target in ["x86-64-v3", "cortex-m4f"] {
+        for (i, (shape, method)) in study::METHODS.into_iter().enumerate() {
+            let shape = match shape {
+                Shape::Triangle => "triangle",
+                Shape::Sphere => "sphere",
+            };
+            for (path, name) in study::PATHS {
+                let n = insns
+                    .iter()
+                    .filter(|r| r.0 == target && r.1 == shape && r.2 == method && r.3 == name)
+                    .count();
+                let want = usize::from(path != study::Path::Precompute || study::precomputes(i));
+                assert_eq!(
+                    n, want,
+                    "{target} {shape} {method} {name} in docs/study-insns.txt"
+                );
+            }
+        }
+    }
 }

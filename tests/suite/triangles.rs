@@ -13,13 +13,16 @@ use raylane::hit::Hit;
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
 use raylane::opcount::{OpCounts, table};
+use raylane::registry::{Kernel, Prim, Visitor};
+use raylane::sphere::SphereKernel;
+use raylane::sphere::focal::FocalKernel;
 use raylane::triangle::focal as tf;
 use raylane::triangle::{
-    self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout,
-    KenslerShirley, Moller, Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket,
-    Wald, Watertight,
+    self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout, Moller,
+    Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
 };
-use raylane::{LaneHit, Ray, RayPacket};
+use raylane::{HitRecord, LaneHit, Ray, RayPacket};
+use std::marker::PhantomData;
 use wide::{f32x4, f32x8, f32x16};
 
 const CULLS: [Cull; 2] = [Cull::None, Cull::Back];
@@ -130,17 +133,71 @@ fn every_kernel<L: Lane<Scalar = f32>>(seed: u64) {
         } else {
             L::LANES
         };
-        kernel::<Cramer, L>(&rays[..n], &tris);
-        kernel::<Moller, L>(&rays[..n], &tris);
-        kernel::<Watertight, L>(&rays[..n], &tris);
-        kernel::<Badouel, L>(&rays[..n], &tris);
-        kernel::<Plucker, L>(&rays[..n], &tris);
-        kernel::<Wald, L>(&rays[..n], &tris);
-        kernel::<HavelHerout, L>(&rays[..n], &tris);
-        kernel::<KenslerShirley, L>(&rays[..n], &tris);
-        kernel::<BaldwinWeber, L>(&rays[..n], &tris);
-        focal_kernel::<L>(&rays[..n], &tris);
+        // Every triangle kernel of the registry.
+        for k in Kernel::of(Prim::Triangle) {
+            k.visit(Lanes::<L>(&rays[..n], &tris, PhantomData));
+        }
     }
+}
+
+/// [`kernel`] or [`focal_kernel`] for a registry kernel.
+struct Lanes<'a, L>(&'a [Ray], &'a [Triangle], PhantomData<L>);
+
+impl<L: Lane<Scalar = f32>> Visitor for Lanes<'_, L> {
+    type Output = ();
+    fn triangle<K: TriangleKernel>(self, _: Kernel) {
+        kernel::<K, L>(self.0, self.1);
+    }
+    fn focal_triangle(self, _: Kernel) {
+        focal_kernel::<L>(self.0, self.1);
+    }
+    fn sphere<K: SphereKernel>(self, k: Kernel) {
+        unreachable!("{} is not a triangle kernel", k.name())
+    }
+    fn focal_sphere<K: FocalKernel>(self, k: Kernel, _: bool) {
+        unreachable!("{} is not a triangle kernel", k.name())
+    }
+    fn plane(self, k: Kernel) {
+        unreachable!("{} is not a triangle kernel", k.name())
+    }
+    fn focal_plane(self, k: Kernel) {
+        unreachable!("{} is not a triangle kernel", k.name())
+    }
+}
+
+/// One ray against one triangle with a registry kernel (the focal cache with the eye at the
+/// ray's origin).
+fn intersect(k: Kernel, ray: &Ray, tri: &Triangle, cull: Cull) -> Option<HitRecord> {
+    struct One<'a>(&'a Ray, &'a Triangle, Cull);
+    impl Visitor for One<'_> {
+        type Output = Option<HitRecord>;
+        fn triangle<K: TriangleKernel>(self, _: Kernel) -> Self::Output {
+            triangle::intersect::<K>(self.0, self.1, self.2)
+        }
+        fn focal_triangle(self, _: Kernel) -> Self::Output {
+            tf::intersect(self.0, &FocalTriangle::new(self.0.origin(), self.1), self.2)
+        }
+        fn sphere<K: SphereKernel>(self, k: Kernel) -> Self::Output {
+            unreachable!("{} is not a triangle kernel", k.name())
+        }
+        fn focal_sphere<K: FocalKernel>(self, k: Kernel, _: bool) -> Self::Output {
+            unreachable!("{} is not a triangle kernel", k.name())
+        }
+        fn plane(self, k: Kernel) -> Self::Output {
+            unreachable!("{} is not a triangle kernel", k.name())
+        }
+        fn focal_plane(self, k: Kernel) -> Self::Output {
+            unreachable!("{} is not a triangle kernel", k.name())
+        }
+    }
+    k.visit(One(ray, tri, cull))
+}
+
+/// One ray against one triangle with every triangle kernel of the registry.
+fn every_intersect(ray: &Ray, tri: &Triangle, cull: Cull) -> Vec<Option<HitRecord>> {
+    Kernel::of(Prim::Triangle)
+        .map(|k| intersect(k, ray, tri, cull))
+        .collect()
 }
 
 #[test]
@@ -459,20 +516,7 @@ fn bad_input_is_a_miss() {
         Vec3::new(0.0, 3.0, 0.0),
     );
     let down = Ray::new(Vec3::new(1.0, 1.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
-    let one = |r: &Ray, t: &Triangle| {
-        [
-            triangle::intersect::<Cramer>(r, t, Cull::None),
-            triangle::intersect::<Moller>(r, t, Cull::None),
-            triangle::intersect::<Watertight>(r, t, Cull::None),
-            triangle::intersect::<Badouel>(r, t, Cull::None),
-            triangle::intersect::<Plucker>(r, t, Cull::None),
-            triangle::intersect::<Wald>(r, t, Cull::None),
-            triangle::intersect::<HavelHerout>(r, t, Cull::None),
-            triangle::intersect::<KenslerShirley>(r, t, Cull::None),
-            triangle::intersect::<BaldwinWeber>(r, t, Cull::None),
-            tf::intersect(r, &FocalTriangle::new(r.origin(), t), Cull::None),
-        ]
-    };
+    let one = |r: &Ray, t: &Triangle| every_intersect(r, t, Cull::None);
     for h in one(&down, &good) {
         let h = h.expect("the base case hits");
         assert_eq!((h.t, h.u), (5.0, 0.25));
@@ -521,28 +565,10 @@ fn bad_input_is_a_miss() {
     }
     // Culling keeps front faces only: the base case is a front face (d·N < 0).
     let up = Ray::new(Vec3::new(1.0, 1.0, -5.0), Vec3::new(0.0, 0.0, 1.0));
-    assert!(triangle::intersect::<Moller>(&down, &good, Cull::Back).is_some());
-    assert!(triangle::intersect::<Cramer>(&down, &good, Cull::Back).is_some());
-    assert!(triangle::intersect::<Watertight>(&down, &good, Cull::Back).is_some());
-    assert!(triangle::intersect::<Badouel>(&down, &good, Cull::Back).is_some());
-    assert!(triangle::intersect::<Plucker>(&down, &good, Cull::Back).is_some());
-    assert!(triangle::intersect::<Wald>(&down, &good, Cull::Back).is_some());
-    assert!(triangle::intersect::<HavelHerout>(&down, &good, Cull::Back).is_some());
-    assert!(triangle::intersect::<KenslerShirley>(&down, &good, Cull::Back).is_some());
-    assert!(triangle::intersect::<BaldwinWeber>(&down, &good, Cull::Back).is_some());
-    assert!(tf::intersect(&down, &FocalTriangle::new(down.origin(), &good), Cull::Back).is_some());
-    for h in [
-        triangle::intersect::<Moller>(&up, &good, Cull::Back),
-        triangle::intersect::<Cramer>(&up, &good, Cull::Back),
-        triangle::intersect::<Watertight>(&up, &good, Cull::Back),
-        triangle::intersect::<Badouel>(&up, &good, Cull::Back),
-        triangle::intersect::<Plucker>(&up, &good, Cull::Back),
-        triangle::intersect::<Wald>(&up, &good, Cull::Back),
-        triangle::intersect::<HavelHerout>(&up, &good, Cull::Back),
-        triangle::intersect::<KenslerShirley>(&up, &good, Cull::Back),
-        triangle::intersect::<BaldwinWeber>(&up, &good, Cull::Back),
-        tf::intersect(&up, &FocalTriangle::new(up.origin(), &good), Cull::Back),
-    ] {
+    for h in every_intersect(&down, &good, Cull::Back) {
+        assert!(h.is_some());
+    }
+    for h in every_intersect(&up, &good, Cull::Back) {
         assert_eq!(h, None);
     }
     // A mesh with out-of-range indices and NaN positions: skipped, never a panic.
@@ -967,25 +993,15 @@ fn kernels_agree_with_each_other() {
             continue;
         }
         for cull in CULLS {
-            let all = [
-                triangle::intersect::<Cramer>(&r, &t, cull),
-                triangle::intersect::<Moller>(&r, &t, cull),
-                triangle::intersect::<Watertight>(&r, &t, cull),
-                triangle::intersect::<Badouel>(&r, &t, cull),
-                triangle::intersect::<Plucker>(&r, &t, cull),
-                triangle::intersect::<Wald>(&r, &t, cull),
-                triangle::intersect::<HavelHerout>(&r, &t, cull),
-                triangle::intersect::<KenslerShirley>(&r, &t, cull),
-                triangle::intersect::<BaldwinWeber>(&r, &t, cull),
-                tf::intersect(&r, &FocalTriangle::new(o, &t), cull),
-            ];
+            let all = every_intersect(&r, &t, cull);
+            let cramer = intersect(Kernel::Cramer, &r, &t, cull);
             let inside = u >= 0.0 && w >= 0.0 && u + w <= 1.0;
             let facing = r.dir().dot(n) < 0.0;
             let want = inside && (cull == Cull::None || facing);
             front += (want && cull == Cull::Back) as usize;
             for h in &all {
                 assert_eq!(h.is_some(), want, "{r:?} {t:?} {cull:?}: {all:?}");
-                if let (Some(h), Some(g)) = (h, all[0]) {
+                if let (Some(h), Some(g)) = (h, cramer) {
                     assert!((h.t - g.t).abs() <= 1e-4 * g.t);
                     assert!((h.u - g.u).abs() <= 1e-4 && (h.v - g.v).abs() <= 1e-4);
                 }

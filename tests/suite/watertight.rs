@@ -17,10 +17,10 @@ use rand::{Rng, SeedableRng};
 use raylane::V3;
 use raylane::demo::shapes;
 use raylane::mesh::Mesh;
-use raylane::triangle::{
-    Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout, KenslerShirley,
-    Moller, Plucker, TriangleKernel, Wald, Watertight,
-};
+use raylane::registry::{Kernel, Prim, Visitor};
+use raylane::sphere::SphereKernel;
+use raylane::sphere::focal::FocalKernel;
+use raylane::triangle::{Cull, FocalRays, FocalTriangle, TriangleKernel};
 use raylane::{Ray, RayPacket};
 
 pub(crate) struct Shape {
@@ -263,49 +263,13 @@ pub(crate) fn cases(s: &Shape, seed: u64) -> Vec<Case> {
     out
 }
 
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub enum Method {
-    Cramer,
-    Moller,
-    Watertight,
-    Focal,
-    Badouel,
-    Plucker,
-    Wald,
-    HavelHerout,
-    KenslerShirley,
-    BaldwinWeber,
-}
+/// The methods compared: every triangle kernel of the registry (named as the checker and the
+/// study table name them: `focal` for the triangle focal cache).
+pub type Method = Kernel;
 
-impl Method {
-    pub const ALL: [Method; 10] = [
-        Method::Cramer,
-        Method::Moller,
-        Method::Watertight,
-        Method::Focal,
-        Method::Badouel,
-        Method::Plucker,
-        Method::Wald,
-        Method::HavelHerout,
-        Method::KenslerShirley,
-        Method::BaldwinWeber,
-    ];
-
-    /// The checker's name (the study table's row).
-    pub fn name(self) -> &'static str {
-        match self {
-            Method::Cramer => Cramer::NAME,
-            Method::Moller => Moller::NAME,
-            Method::Watertight => Watertight::NAME,
-            Method::Focal => "focal",
-            Method::Badouel => Badouel::NAME,
-            Method::Plucker => Plucker::NAME,
-            Method::Wald => Wald::NAME,
-            Method::HavelHerout => HavelHerout::NAME,
-            Method::KenslerShirley => KenslerShirley::NAME,
-            Method::BaldwinWeber => BaldwinWeber::NAME,
-        }
-    }
+/// Every triangle kernel of the registry.
+pub fn methods() -> impl Iterator<Item = Method> {
+    Kernel::of(Prim::Triangle)
 }
 
 /// All hits `(t, triangle)` of one ray.
@@ -313,32 +277,46 @@ fn hits(m: Method, s: &Shape, ray: &Ray, cache: &mut [FocalTriangle<f32>]) -> Ve
     let mesh = Mesh::new(&s.pos, &s.idx);
     let rp = RayPacket::<f32>::splat(ray);
     let mut out = Vec::new();
-    let mut push = |i: u32, h: &raylane::LaneHit<f32>| {
+    let push = |i: u32, h: &raylane::LaneHit<f32>| {
         assert!(h.t.is_finite() && h.u.is_finite() && h.v.is_finite());
         out.push((h.t, i));
     };
-    fn run<K: TriangleKernel>(
-        mesh: &Mesh,
-        rp: &RayPacket<f32>,
-        f: impl FnMut(u32, &raylane::LaneHit<f32>),
-    ) {
-        mesh.all::<K, f32>(rp, Cull::None, f);
+    struct All<'a, F> {
+        mesh: &'a Mesh<'a>,
+        rp: &'a RayPacket<f32>,
+        eye: Vec3,
+        cache: &'a mut [FocalTriangle<f32>],
+        push: F,
     }
-    match m {
-        Method::Cramer => run::<Cramer>(&mesh, &rp, &mut push),
-        Method::Moller => run::<Moller>(&mesh, &rp, &mut push),
-        Method::Watertight => run::<Watertight>(&mesh, &rp, &mut push),
-        Method::Badouel => run::<Badouel>(&mesh, &rp, &mut push),
-        Method::Plucker => run::<Plucker>(&mesh, &rp, &mut push),
-        Method::Wald => run::<Wald>(&mesh, &rp, &mut push),
-        Method::HavelHerout => run::<HavelHerout>(&mesh, &rp, &mut push),
-        Method::KenslerShirley => run::<KenslerShirley>(&mesh, &rp, &mut push),
-        Method::BaldwinWeber => run::<BaldwinWeber>(&mesh, &rp, &mut push),
-        Method::Focal => {
-            let fm = mesh.focus(ray.origin(), cache);
-            fm.all(&FocalRays::new(&rp), Cull::None, &mut push);
+    impl<F: FnMut(u32, &raylane::LaneHit<f32>)> Visitor for All<'_, F> {
+        type Output = ();
+        fn triangle<K: TriangleKernel>(self, _: Kernel) {
+            self.mesh.all::<K, f32>(self.rp, Cull::None, self.push);
+        }
+        fn focal_triangle(self, _: Kernel) {
+            let fm = self.mesh.focus(self.eye, self.cache);
+            fm.all(&FocalRays::new(self.rp), Cull::None, self.push);
+        }
+        fn sphere<K: SphereKernel>(self, k: Kernel) {
+            unreachable!("{} is not a triangle kernel", k.name())
+        }
+        fn focal_sphere<K: FocalKernel>(self, k: Kernel, _: bool) {
+            unreachable!("{} is not a triangle kernel", k.name())
+        }
+        fn plane(self, k: Kernel) {
+            unreachable!("{} is not a triangle kernel", k.name())
+        }
+        fn focal_plane(self, k: Kernel) {
+            unreachable!("{} is not a triangle kernel", k.name())
         }
     }
+    m.visit(All {
+        mesh: &mesh,
+        rp: &rp,
+        eye: ray.origin(),
+        cache,
+        push,
+    });
     out.sort_by(|a, b| a.0.total_cmp(&b.0));
     out
 }
@@ -396,7 +374,7 @@ fn judge(h: &[(f32, u32)], crossings: usize, t: &mut Tally) {
 #[test]
 fn closed_meshes_leak_and_double_hit_counts() {
     let shapes = shapes();
-    let methods = Method::ALL;
+    let methods: Vec<Method> = methods().collect();
     let mut total: HashMap<(Method, Target), Tally> = HashMap::new();
     println!("watertightness: rays aimed at shared vertices/edges and random surface points");
     println!("| mesh | method | target | rays | leaks | double hits | extra hits |");
@@ -408,7 +386,7 @@ fn closed_meshes_leak_and_double_hit_counts() {
         let mut axis_rays = 0;
         for c in &cs {
             axis_rays += c.axis as usize;
-            for m in methods {
+            for &m in &methods {
                 let h = hits(m, s, &c.ray, &mut cache);
                 judge(&h, c.crossings, tally.entry((m, c.target)).or_default());
             }
@@ -434,7 +412,7 @@ fn closed_meshes_leak_and_double_hit_counts() {
         );
     }
     println!("\ntotals per method:");
-    for m in methods {
+    for &m in &methods {
         let t = total
             .iter()
             .filter(|(k, _)| k.0 == m)
@@ -449,8 +427,8 @@ fn closed_meshes_leak_and_double_hit_counts() {
             t.rays, t.leaks, t.doubles, t.extra
         );
         match m {
-            Method::Watertight | Method::Plucker => assert_eq!(t.leaks, 0, "{m:?} leaks"),
-            Method::Focal => {
+            Kernel::Watertight | Kernel::Plucker => assert_eq!(t.leaks, 0, "{m:?} leaks"),
+            Kernel::TriangleFocal => {
                 assert_eq!(t.leaks, 0, "focal leaks");
                 assert_eq!(t.doubles, 0, "focal double hits");
                 assert_eq!(t.extra, 0, "focal extra hits");

@@ -11,7 +11,8 @@
 #![no_std]
 #![no_main]
 
-use raylane::demo::{self, Frame, Method, Storage, scenes::Mix};
+use raylane::demo::{self, Frame, Storage, scenes::Mix};
+use raylane::registry::Kernel;
 use raylane::triangle::FocalTriangle;
 use raylane_fw::semihosting::{hprintln, nr, syscall};
 use raylane_fw::{entry, exit};
@@ -67,7 +68,7 @@ fn main() -> ! {
         planes: &mut planes,
         triangles: &mut triangles,
     };
-    let frame = match Frame::new(mix.scene(), Mix::camera(W, H), Method::Focal, storage) {
+    let frame = match Frame::new(mix.scene(), Mix::camera(W, H), Kernel::Focal, storage) {
         Ok(f) => f,
         Err(e) => {
             hprintln!("render mix ... cannot set up the frame ({:?})", e);
