@@ -122,7 +122,7 @@ impl<'a> Mesh<'a> {
         };
         match (p(a), p(b), p(c)) {
             (Some(a), Some(b), Some(c)) if self.invalid == 0 || !listed() => {
-                Triangle::valid(a, b, c)
+                Triangle::stored(a, b, c)
             }
             _ => Triangle::never(),
         }

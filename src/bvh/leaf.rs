@@ -145,8 +145,8 @@ impl Tri4 {
         if self.index[k] == EMPTY {
             return Triangle::never();
         }
-        // Stored as `Triangle::new` made it, which gives it back unchanged.
-        Triangle::new(get(&self.a, k), get(&self.b, k), get(&self.c, k))
+        // Stored as `Triangle::new` made it (NaN for one that is never hit).
+        Triangle::stored(get(&self.a, k), get(&self.b, k), get(&self.c, k))
     }
 
     fn set_triangle(&mut self, k: usize, t: &Triangle, index: u32) {
@@ -349,9 +349,21 @@ impl Primitives for Mesh<'_> {
     fn count(&self) -> usize {
         self.len()
     }
+    /// The box of the vertices' finite coordinates (cheaper than validating the triangle:
+    /// one that is never hit may get a box, and is still never hit).
     fn bounds(&self, i: u32) -> ([f32; 3], [f32; 3]) {
-        let t = self.triangle(i as usize).unwrap_or(Triangle::never());
-        points_box(&[t.a(), t.b(), t.c()])
+        let Some(idx) = self.indices().get(i as usize) else {
+            return points_box(&[]);
+        };
+        let p = idx.map(|k| {
+            let v = self
+                .positions()
+                .get(k as usize)
+                .copied()
+                .unwrap_or(Vec3::NAN);
+            Vec3::select(v.is_finite_mask(), v, Vec3::NAN)
+        });
+        points_box(&p)
     }
     fn put(&self, i: u32, leaf: &mut Tri4, k: usize) {
         let t = self.triangle(i as usize).unwrap_or(Triangle::never());

@@ -26,8 +26,8 @@ use glam::Vec3;
 use super::leaf::points_box;
 use super::traverse::{Slab, Stack};
 use super::{
-    BuildError, Bvh, EMPTY, LEAF, LEAF_WIDTH, Leaf, Node, Packed, Primitives, Scratch, WIDTH,
-    build, max, min,
+    BuildError, Bvh, EMPTY, LEAF, LEAF_WIDTH, Leaf, Node, Packed, Primitives, STACK, Scratch,
+    WIDTH, build, max, min,
 };
 use crate::hit::relax;
 use crate::lane::{Lane, Mask};
@@ -267,7 +267,7 @@ impl<'s, P: Leaf> Scene<'s, P> {
         let t_end = ray.t_max();
         let mut t_max = relax(t_end);
         let mut best: Option<Hit> = None;
-        let mut stack = Stack::new();
+        let mut stack = Stack::<STACK>::new();
         while let Some((c, tn)) = stack.pop() {
             if tn > t_max {
                 continue;
@@ -394,7 +394,7 @@ impl<P: Leaf> Scene<'_, P> {
             return;
         }
         let slab = Slab::new(ray.origin(), ray.dir(), self.top.reach);
-        let mut stack = Stack::new();
+        let mut stack = Stack::<STACK>::new();
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 if let Some(n) = self.top.nodes.get(c as usize) {

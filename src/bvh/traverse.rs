@@ -95,23 +95,34 @@ impl Slab {
     }
 }
 
+/// Entries of the short stack the one-ray queries try first (a query that would overflow it
+/// runs again with the full [`STACK`]: initialising 2 KB per ray cost about a fifth of a
+/// primary ray's time).
+const SHORT: usize = 32;
+
 /// The traversal stack: node references with the entry parameter of their box (the root
-/// first, with `−inf`).
-pub(crate) struct Stack {
-    node: [u32; STACK],
-    tn: [f32; STACK],
+/// first, with `−inf`). With `N < STACK` a push may not fit: the stack then records the
+/// overflow and the query is run again with a full stack.
+pub(crate) struct Stack<const N: usize = STACK> {
+    node: [u32; N],
+    tn: [f32; N],
     len: usize,
+    /// An entry was dropped: the answer is incomplete.
+    pub(crate) overflow: bool,
 }
 
-impl Stack {
+impl<const N: usize> Stack<N> {
     #[inline(always)]
     pub(crate) fn new() -> Self {
         let mut s = Stack {
-            node: [0; STACK],
-            tn: [0.0; STACK],
+            node: [0; N],
+            tn: [0.0; N],
             len: 1,
+            overflow: false,
         };
-        s.tn[0] = f32::NEG_INFINITY;
+        if let Some(t) = s.tn.first_mut() {
+            *t = f32::NEG_INFINITY;
+        }
         s
     }
 
@@ -144,10 +155,15 @@ impl Stack {
                 *a = c;
                 *b = t;
                 self.len += 1;
+            } else {
+                self.overflow = true;
             }
         }
     }
 }
+
+/// One ray's finished closest hit and its primitive.
+pub(crate) type Winner<P> = (Best<f32>, <P as Leaf>::Prim);
 
 /// The best hit of one ray so far, and where its primitive sits (leaf, lane).
 #[derive(Clone, Copy, Debug)]
@@ -164,9 +180,19 @@ struct One {
 impl<P: Leaf> Bvh<'_, P> {
     /// The closest hit of one ray (finished, as a one-lane [`Best`]) and its primitive: the
     /// brute-force answer with the same kernel, bit for bit (see the [module docs](super)).
-    pub(crate) fn closest_one(&self, ray: &Ray) -> Option<(Best<f32>, P::Prim)> {
+    pub(crate) fn closest_one(&self, ray: &Ray) -> Option<Winner<P>> {
+        match self.closest_with::<SHORT>(ray) {
+            Ok(h) => h,
+            Err(()) => self.closest_with::<STACK>(ray).ok().flatten(),
+        }
+    }
+
+    /// [`closest_one`](Self::closest_one) with a stack of `N` entries: `Err` when it
+    /// overflowed (never with `N = STACK`, by the depth bound).
+    #[inline(always)]
+    fn closest_with<const N: usize>(&self, ray: &Ray) -> Result<Option<Winner<P>>, ()> {
         if !ray.is_valid() {
-            return None;
+            return Ok(None);
         }
         let slab = Slab::new(ray.origin(), ray.dir(), self.reach);
         let r4 = RayPacket::<f32x4>::splat(ray);
@@ -182,7 +208,7 @@ impl<P: Leaf> Bvh<'_, P> {
             leaf: 0,
             lane: 0,
         };
-        let mut stack = Stack::new();
+        let mut stack = Stack::<N>::new();
         while let Some((c, tn)) = stack.pop() {
             if tn > t_max {
                 continue;
@@ -223,23 +249,38 @@ impl<P: Leaf> Bvh<'_, P> {
                 }
             }
         }
-        if best.index == EMPTY {
-            return None;
+        if stack.overflow {
+            return Err(());
         }
-        let prim = self.leaves.get(best.leaf as usize)?.prim(best.lane);
+        if best.index == EMPTY {
+            return Ok(None);
+        }
+        let Some(leaf) = self.leaves.get(best.leaf as usize) else {
+            return Ok(None);
+        };
         let h = LaneHit::deferred(best.t, best.u, best.v, best.w, true);
-        Some((Best::single(&h, best.index), prim))
+        Ok(Some((Best::single(&h, best.index), leaf.prim(best.lane))))
     }
 
     /// True when one ray hits some primitive (stops at the first hit).
     pub(crate) fn any_one(&self, ray: &Ray) -> bool {
+        match self.any_with::<SHORT>(ray) {
+            Some(hit) => hit,
+            None => self.any_with::<STACK>(ray).unwrap_or(false),
+        }
+    }
+
+    /// [`any_one`](Self::any_one) with a stack of `N` entries: `None` when it overflowed
+    /// before finding a hit.
+    #[inline(always)]
+    fn any_with<const N: usize>(&self, ray: &Ray) -> Option<bool> {
         if !ray.is_valid() {
-            return false;
+            return Some(false);
         }
         let slab = Slab::new(ray.origin(), ray.dir(), self.reach);
         let r4 = RayPacket::<f32x4>::splat(ray);
         let pre = P::prepare(&r4);
-        let mut stack = Stack::new();
+        let mut stack = Stack::<N>::new();
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 let Some(n) = self.nodes.get(c as usize) else {
@@ -250,10 +291,10 @@ impl<P: Leaf> Bvh<'_, P> {
             } else if let Some(leaf) = self.leaves.get((c & !LEAF) as usize)
                 && leaf.test_four(&r4, &pre, self.cull).mask.any()
             {
-                return true;
+                return Some(true);
             }
         }
-        false
+        (!stack.overflow).then_some(false)
     }
 }
 
@@ -377,7 +418,7 @@ impl<P: Leaf> Bvh<'_, P> {
             t_max: L::select(valid, relax(rays.t_max), rays.t_max),
             ..*rays
         };
-        let mut stack = Stack::new();
+        let mut stack = Stack::<STACK>::new();
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
@@ -435,7 +476,7 @@ impl<P: Leaf> Bvh<'_, P> {
         }
         let slab = PacketSlab::new(rays, self.reach);
         let pre = P::prepare(rays);
-        let mut stack = Stack::new();
+        let mut stack = Stack::<STACK>::new();
         while let Some((c, _)) = stack.pop() {
             let active = valid.and_not(hit);
             if c & LEAF == 0 {
@@ -468,7 +509,7 @@ impl<P: Leaf> Bvh<'_, P> {
         }
         let slab = PacketSlab::new(rays, self.reach);
         let pre = P::prepare(rays);
-        let mut stack = Stack::new();
+        let mut stack = Stack::<STACK>::new();
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {

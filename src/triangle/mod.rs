@@ -145,10 +145,12 @@ impl Triangle {
         }
     }
 
-    /// A triangle already known to be valid (finite, nonzero area): no check.
+    /// Vertices exactly as [`Triangle::new`] stored them (NaN for a triangle that is never
+    /// hit), without its checks: for copies of valid triangles (a `Mesh` checked once when built,
+    /// the BVH's leaves).
     #[inline(always)]
     #[must_use]
-    pub(crate) fn valid(a: Vec3, b: Vec3, c: Vec3) -> Self {
+    pub(crate) const fn stored(a: Vec3, b: Vec3, c: Vec3) -> Self {
         Triangle { a, b, c }
     }
 

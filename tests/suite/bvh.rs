@@ -517,6 +517,14 @@ fn depth_is_bounded_and_ties_go_to_the_lowest_index() {
     assert_eq!(tree.closest(&ray).unwrap().index, 0);
     let p = RayPacket::<f32x8>::splat(&ray);
     assert_eq!(tree.closest(&p).lane(5).unwrap().index, 0);
+    // 300,000 copies: six levels whose every box a ray enters, so the one-ray queries
+    // short stack overflows and they run again with the full one.
+    let copies = vec![tri; 300_000];
+    let (nodes, leaves) = owned(&copies[..]);
+    let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
+    assert!(tree.stats().depth >= 6, "{:?}", tree.stats());
+    assert_eq!(tree.closest(&ray).unwrap().index, 0);
+    assert!(tree.any(&ray));
 
     let row: Vec<Triangle> = (0..400)
         .map(|i| {
