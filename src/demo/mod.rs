@@ -50,6 +50,7 @@
 //! [`FocalMesh`]: crate::mesh::FocalMesh
 //! [`Mesh::bounded`]: crate::mesh::Mesh::bounded
 
+pub mod bunny;
 mod frame;
 mod image;
 mod render;
