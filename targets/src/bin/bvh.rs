@@ -11,7 +11,7 @@
 //! [`bvh_end`], so the TCG plugin's windows (`targets/plugin`, `start=`/`stop=`) count the
 //! executed instructions of each (window 1: build, windows 2–5: x1, x4, x8, x16).
 //!
-//! Output: `bvh bunny: N triangles, N nodes, N leaves, N B of tree storage (N B used)`, one
+//! Output: `bvh bunny: N triangles, N nodes, N leaves, N B of tree storage (N B used), …`, `bvh stack storage: N B` (every array, on the stack), one
 //! `render bunny-fw 64x48 xN: fnv1a HEX, N of N rays hit` line per width and
 //! `wrote PATH (N bytes)`; exits non-zero when the build fails, the widths differ or the file
 //! cannot be written.
@@ -128,6 +128,15 @@ fn main() -> ! {
         size_of_val(tree.nodes()) + size_of_val(tree.leaves()),
         SIZES.scratch * size_of::<Scratch>(),
         size_of_val(&tris)
+    );
+    // Every array of this function, all on the stack (RAM beside .data and .bss).
+    hprintln!(
+        "bvh stack storage: {} B",
+        size_of_val(&tris)
+            + SIZES.nodes * size_of::<Node>()
+            + SIZES.leaves * size_of::<Tri4>()
+            + SIZES.scratch * size_of::<Scratch>()
+            + 2 * 3 * PIXELS
     );
     let cam = bunny::camera(&tris[..n], W, H);
     let mut rgb = [0u8; 3 * PIXELS];
