@@ -11,6 +11,8 @@
 //!   --lanes N          rays per packet: 1, 4, 8 or 16 (default: the compiled SIMD width)
 //!   --threads N        worker threads (default: every core)
 //!   --ppm FILE         write one scene as a binary PPM instead (the firmware comparison)
+//!   --scene bunny-fw   (not among the six) the firmware `bvh`'s picture: the vendored bunny's
+//!                      primary rays through the BVH, one thread (`raylane::demo::bunny`)
 //! ```
 //!
 //! 1. `1-precision.png`: the precision lecture's unit sphere 100 units (top row) and 4100 units
@@ -443,7 +445,7 @@ fn parse() -> Result<Options, String> {
         o.scenes.push("obj".into());
     }
     for s in &o.scenes {
-        if !SCENES.contains(&s.as_str()) && s != "obj" {
+        if !SCENES.contains(&s.as_str()) && s != "obj" && s != "bunny-fw" {
             return Err(format!("unknown scene {s}"));
         }
     }
@@ -487,6 +489,7 @@ fn main() -> ExitCode {
             "ground" => ground(&o),
             "mesh" => mesh(&o),
             "mix" => mix(&o),
+            "bunny-fw" => bunny_fw(&o),
             _ => match traced(&o, name) {
                 Ok(r) => r,
                 Err(e) => {
@@ -653,6 +656,42 @@ fn mesh(o: &Options) -> (&'static str, Picture, usize) {
 }
 
 /// Scene 4: spheres, meshes and a plane.
+/// The firmware `bvh`'s picture (`targets/src/bin/bvh.rs`): the vendored bunny's BVH built by
+/// `raylane::demo::bunny`'s code on one thread, primary rays only.
+fn bunny_fw(o: &Options) -> (&'static str, Picture, usize) {
+    use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
+    use raylane::demo::bunny;
+    let (w, h) = o.size.unwrap_or(bunny::SIZE);
+    let start = Instant::now();
+    let mut tris = vec![raylane::triangle::Triangle::never(); bunny::TRIANGLES];
+    let n = bunny::load(include_bytes!("../tests/data/bunny.bin"), &mut tris)
+        .expect("tests/data/bunny.bin is well formed");
+    tris.truncate(n);
+    let need = bvh::needed(n);
+    let mut nodes = vec![Node::EMPTY; need.nodes];
+    let mut leaves = vec![<Tri4 as Packed>::EMPTY; need.leaves];
+    let mut scratch = vec![Scratch::default(); need.scratch];
+    let tree = bvh::build(&tris[..], &mut nodes[..], &mut leaves[..], &mut scratch[..])
+        .expect("storage sized by bvh::needed");
+    let cam = bunny::camera(&tris, w, h);
+    let mut rgb = vec![0u8; 3 * w as usize * h as usize];
+    let hits = match o.lanes {
+        1 => bunny::render::<f32>(&tree, &cam, &mut rgb),
+        4 => bunny::render::<f32x4>(&tree, &cam, &mut rgb),
+        8 => bunny::render::<f32x8>(&tree, &cam, &mut rgb),
+        _ => bunny::render::<f32x16>(&tree, &cam, &mut rgb),
+    };
+    debug_assert!(hits.is_some(), "the image buffer is sized for the camera");
+    let pic = Picture {
+        width: w,
+        height: h,
+        rgb,
+        stats: Stats::default(),
+        time: start.elapsed(),
+    };
+    ("bunny-fw.png", pic, 1)
+}
+
 fn mix(o: &Options) -> (&'static str, Picture, usize) {
     let (w, h) = o.size.unwrap_or((800, 600));
     let m = Mix::new();

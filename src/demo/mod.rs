@@ -42,7 +42,9 @@
 //!
 //! **Files.** Scene types and cameras (`scene.rs`), frame setup and caller
 //! storage (`frame.rs`), the tile loop and closest hits (`render.rs`), shading (`shade.rs`),
-//! tiles and counts (`tile.rs`), image output (`image.rs`).
+//! tiles and counts (`tile.rs`), image output (`image.rs`); the vendored bunny through the
+//! BVH, the picture the firmware `bvh` and the host's `render --scene bunny-fw` share
+//! ([`bunny`]).
 //!
 //! [`Pinhole::row_packet`]: crate::camera::Pinhole::row_packet
 //! [`FocalSphere`]: crate::sphere::FocalSphere
@@ -50,6 +52,7 @@
 //! [`FocalMesh`]: crate::mesh::FocalMesh
 //! [`Mesh::bounded`]: crate::mesh::Mesh::bounded
 
+pub mod bunny;
 mod frame;
 mod image;
 mod render;

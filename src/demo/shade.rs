@@ -82,6 +82,6 @@ fn sky(d: V3<f32>) -> [f32; 3] {
 }
 
 /// Linear RGB in `[0, 1]` to RGB8 with a gamma of 2 (a square root).
-fn to_rgb(c: [f32; 3]) -> [u8; 3] {
+pub(super) fn to_rgb(c: [f32; 3]) -> [u8; 3] {
     c.map(|x| (sqrt_f32(x.clamp(0.0, 1.0)) * 255.0 + 0.5) as u8)
 }

@@ -421,3 +421,36 @@ fn frames_refuse_short_storage_and_render_into_short_buffers() {
     assert_eq!(&head[..k], b"P6\n64 48\n255\n");
     assert_eq!(demo::ppm_header(64, 48, &mut head[..5]), None);
 }
+
+/// The firmware `bvh`'s picture (`raylane::demo::bunny`, `targets/src/bin/bvh.rs`): the vendored
+/// bunny loads, its BVH builds in `bvh::needed` storage, and the 64×48 render gives the same
+/// bytes at every lane width, pinned by the digest the Cortex-M4F and M33 print.
+#[test]
+fn bunny_fw_render_is_pinned_at_every_width() {
+    use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
+    use raylane::demo::bunny;
+    use raylane::triangle::Triangle;
+    let bin = include_bytes!("../data/bunny.bin");
+    let mut tris = vec![Triangle::never(); bunny::TRIANGLES];
+    assert_eq!(bunny::load(bin, &mut tris), Some(bunny::TRIANGLES));
+    assert_eq!(bunny::load(&bin[..bin.len() - 1], &mut tris), None);
+    assert_eq!(bunny::load(bin, &mut tris[..10]), None);
+    let need = bvh::needed(tris.len());
+    let mut nodes = vec![Node::EMPTY; need.nodes];
+    let mut leaves = vec![<Tri4 as Packed>::EMPTY; need.leaves];
+    let mut scratch = vec![Scratch::default(); need.scratch];
+    let tree = bvh::build(&tris[..], &mut nodes[..], &mut leaves[..], &mut scratch[..]).unwrap();
+    let (w, h) = bunny::SIZE;
+    let cam = bunny::camera(&tris, w, h);
+    let image = |f: fn(&bvh::TriangleBvh, &raylane::Pinhole, &mut [u8]) -> Option<u32>| {
+        let mut rgb = vec![0u8; 3 * (w * h) as usize];
+        assert_eq!(f(&tree, &cam, &mut rgb), Some(979));
+        assert_eq!(f(&tree, &cam, &mut rgb[1..]), None);
+        rgb
+    };
+    let one = image(bunny::render::<f32>);
+    assert_eq!(demo::fnv1a(&one), 0xc4c0_3850_74ed_2589);
+    assert_eq!(image(bunny::render::<f32x4>), one);
+    assert_eq!(image(bunny::render::<f32x8>), one);
+    assert_eq!(image(bunny::render::<f32x16>), one);
+}

@@ -1,0 +1,117 @@
+//! The vendored Stanford bunny (`tests/data/bunny.bin`, 3,674 triangles) through the BVH
+//! ([`crate::bvh`]): loading, camera and a primary-ray render shared by the host's `render`
+//! example (`--scene bunny-fw`) and the firmware `targets/src/bin/bvh.rs`, which compares the
+//! two byte for byte at every packet width (`scripts/test.sh`).
+//!
+//! Shading uses `+ − × ÷ √` and compares only, as the other demo scenes: Lambert's law under
+//! one directional light with an ambient term, by the hit's geometric normal (facing the eye),
+//! a gamma of 2, and a vertical gradient where rays miss.
+
+use glam::Vec3;
+
+use super::shade::to_rgb;
+use crate::bvh::TriangleBvh;
+use crate::camera::Pinhole;
+use crate::lane::Lane;
+use crate::query::Query;
+use crate::triangle::Triangle;
+
+/// Triangles of the vendored bunny.
+pub const TRIANGLES: usize = 3674;
+
+/// The firmware's image size.
+pub const SIZE: (u32, u32) = (64, 48);
+
+/// Reads `bunny.bin` (u32 vertex count, u32 triangle count, f32 x, y, z per vertex, u16 ×3
+/// per triangle, little-endian) into `out`; returns the number of triangles, or `None` when
+/// the bytes are malformed (wrong length, an index out of range) or `out` is too short.
+#[must_use]
+pub fn load(bin: &[u8], out: &mut [Triangle]) -> Option<usize> {
+    let u32_at = |o: usize| Some(u32::from_le_bytes(bin.get(o..o + 4)?.try_into().ok()?));
+    let f32_at = |o: usize| Some(f32::from_le_bytes(bin.get(o..o + 4)?.try_into().ok()?));
+    let (nv, nt) = (u32_at(0)? as usize, u32_at(4)? as usize);
+    let base = nv.checked_mul(12)?.checked_add(8)?;
+    if bin.len() != base.checked_add(nt.checked_mul(6)?)? || out.len() < nt {
+        return None;
+    }
+    let vertex = |i: usize| {
+        let o = 8 + 12 * i;
+        (i < nv).then_some(())?;
+        Some(Vec3::new(f32_at(o)?, f32_at(o + 4)?, f32_at(o + 8)?))
+    };
+    let index = |o: usize| Some(u16::from_le_bytes(bin.get(o..o + 2)?.try_into().ok()?) as usize);
+    for (k, t) in out[..nt].iter_mut().enumerate() {
+        let o = base + 6 * k;
+        *t = Triangle::new(
+            vertex(index(o)?)?,
+            vertex(index(o + 2)?)?,
+            vertex(index(o + 4)?)?,
+        );
+    }
+    Some(nt)
+}
+
+/// The camera: 40° vertical field of view, from the front (+z), slightly above and to the
+/// right, at 2.2 bounding radii from the centre of the triangles' bounding box.
+#[must_use]
+pub fn camera(tris: &[Triangle], width: u32, height: u32) -> Pinhole {
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for t in tris {
+        for p in [t.a(), t.b(), t.c()] {
+            if p.is_finite() {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+        }
+    }
+    if !(lo.cmple(hi).all()) {
+        (lo, hi) = (Vec3::splat(-1.0), Vec3::splat(1.0));
+    }
+    let centre = (lo + hi) * 0.5;
+    let radius = (hi - lo).length() * 0.5;
+    let dir = Vec3::new(0.25, 0.3, 1.0).normalize();
+    Pinhole::look_at(
+        centre + dir * (2.2 * radius),
+        centre,
+        Vec3::Y,
+        40.0,
+        width,
+        height,
+    )
+}
+
+/// Renders every primary ray of `cam` through `tree`, `L` rays per packet, into `rgb` (RGB8,
+/// row-major, `3 · width · height` bytes); returns the number of rays that hit, or `None`
+/// when `rgb` has the wrong length.
+pub fn render<L: Lane<Scalar = f32>>(
+    tree: &TriangleBvh,
+    cam: &Pinhole,
+    rgb: &mut [u8],
+) -> Option<u32> {
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    if rgb.len() != 3 * w * h {
+        return None;
+    }
+    let light = Vec3::new(-1.0, 2.0, 1.5).normalize();
+    let mut hits = 0;
+    for y in 0..cam.height {
+        let s = y as f32 / cam.height as f32;
+        let sky = [0.16, 0.2, 0.28].map(|c| c * (1.0 - 0.5 * s));
+        for x in (0..cam.width).step_by(L::LANES) {
+            let found = tree.closest_packet(&cam.row_packet::<L>(x, y));
+            for i in 0..L::LANES.min((cam.width - x) as usize) {
+                let c = match found.lane(i) {
+                    Some(hit) => {
+                        hits += 1;
+                        let k = 0.15 + 0.85 * hit.normal.dot(light).max(0.0);
+                        [0.92 * k, 0.85 * k, 0.74 * k]
+                    }
+                    None => sky,
+                };
+                let at = 3 * (y as usize * w + x as usize + i);
+                rgb[at..at + 3].copy_from_slice(&to_rgb(c));
+            }
+        }
+    }
+    Some(hits)
+}
