@@ -144,7 +144,7 @@ impl<L: Lane> Best<L> {
     /// No hit in any lane.
     #[inline]
     #[must_use]
-    pub fn none() -> Self {
+    pub fn miss() -> Self {
         let m = LaneHit::<L>::miss();
         Best {
             t: m.t,
@@ -176,7 +176,7 @@ impl<L: Lane> Best<L> {
     #[inline(always)]
     #[must_use]
     pub(crate) fn single(h: &LaneHit<L>, index: u32) -> Self {
-        let mut b = Self::none();
+        let mut b = Self::miss();
         b.take(h, h.mask, index);
         b.finish()
     }
@@ -248,7 +248,7 @@ pub fn closest<L: Lane, P>(
     mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
 ) -> Best<L> {
     let mut r = *rays;
-    let mut best = Best::none();
+    let mut best = Best::miss();
     for (i, p) in prims.into_iter().enumerate() {
         // `None`: no lane passed the kernel's first test (nothing to merge on the miss path).
         if let Some(h) = test(&r, p) {
@@ -330,7 +330,7 @@ pub fn closest_filtered<L: Lane, P>(
         return closest(rays, prims, test);
     }
     let mut r = *rays;
-    let mut best = Best::none();
+    let mut best = Best::miss();
     for (b, block) in prims.chunks(64).enumerate() {
         let mut bits = candidates(&r, block, &mut candidate);
         while bits != 0 {
@@ -393,7 +393,7 @@ where
     L::Scalar: Scalar,
 {
     let mut r = RayPacket::<L>::splat(ray);
-    let mut best = Best::<L>::none();
+    let mut best = Best::<L>::miss();
     for (c, p) in chunks.into_iter().enumerate() {
         let Some(h) = test(&r, p) else { continue };
         let take = closer(&h, &best);

@@ -421,7 +421,7 @@ impl<K: TriangleKernel> Query for Using<'_, Mesh<'_>, K> {
     fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
         let (m, cull) = (self.set(), self.cull());
         let Some(r) = m.kept(rays) else {
-            return Hits::none();
+            return Hits::miss();
         };
         let pre = K::prepare(&r);
         let best = hit::closest(&r, 0..m.len(), |r, i| {
@@ -477,7 +477,7 @@ impl Query for FocalMesh<'_> {
         let r = query::at_eye(rays, self.eye);
         let best = self
             .try_closest(&FocalRays::new(&r), self.cull)
-            .unwrap_or_else(Best::none);
+            .unwrap_or_else(Best::miss);
         Hits::from_triangles(&r, &best, self.cull, |i| {
             self.cache.get(i as usize).map(|e| e.triangle())
         })
