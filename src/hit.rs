@@ -320,7 +320,7 @@ fn candidates<L: Lane, P>(
 /// One lane takes a single pass ([`closest`]): `test` stops where the first pass would, and
 /// LLVM turns a one-lane first pass into gathers across primitives (4× slower on x86-64).
 #[inline]
-pub fn closest_filtered<L: Lane, P>(
+pub(crate) fn closest_filtered<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: &[P],
     mut candidate: impl FnMut(&RayPacket<L>, &P) -> L::Mask,
@@ -351,7 +351,7 @@ pub fn closest_filtered<L: Lane, P>(
 /// [`any`] in two passes per block of 64 primitives (one lane: a single pass), as
 /// [`closest_filtered`].
 #[inline]
-pub fn any_filtered<L: Lane, P>(
+pub(crate) fn any_filtered<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: &[P],
     mut candidate: impl FnMut(&RayPacket<L>, &P) -> L::Mask,

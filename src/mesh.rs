@@ -470,7 +470,7 @@ impl Query for Mesh<'_> {
 /// Focal meshes: rays whose origin is not exactly the cache's eye miss (see
 /// [`FocalMesh::eye`]); the others are prepared once ([`FocalRays`]), culled by the bound, and
 /// tested against the entries in index order (two passes per block, as
-/// [`hit::closest_filtered`]). Culling: [`FocalMesh::culled`].
+/// `hit::closest_filtered`). Culling: [`FocalMesh::culled`].
 impl Query for FocalMesh<'_> {
     #[inline]
     fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {

@@ -10,7 +10,8 @@ use crate::ray::RayPacket;
 use crate::registry::{Kernel, Visitor};
 use crate::sphere::focal::{self as sf, FocalKernel};
 use crate::sphere::{self, FocalSphere, Sphere, SphereKernel};
-use crate::triangle::{Cull, FocalRays, TriangleKernel, Watertight};
+use crate::triangle::focal::FocalRays;
+use crate::triangle::{Cull, TriangleKernel, Watertight};
 
 /// What is hit in each lane of a packet, merged over the kinds of primitive.
 #[derive(Clone, Copy, Debug)]

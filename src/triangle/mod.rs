@@ -87,7 +87,7 @@ mod watertight;
 pub use badouel::{Badouel, BadouelRecord};
 pub use baldwin::{AffineRecord, BaldwinWeber};
 pub use cramer::Cramer;
-pub use focal::{FocalRays, FocalTriangle};
+pub use focal::FocalTriangle;
 pub use havel::{HavelHerout, PlanesRecord};
 pub use kensler::KenslerShirley;
 pub use moller::Moller;
@@ -382,6 +382,7 @@ pub(crate) fn within<L: Lane>(
 /// The hit of one ray on one triangle with kernel `K`, or `None`.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn intersect<K: TriangleKernel>(ray: &Ray, tri: &Triangle, cull: Cull) -> Option<HitRecord> {
     let r = RayPacket::<f32>::splat(ray);
     K::intersect(&r, &K::prepare(&r), &TrianglePacket::splat(tri), cull)
@@ -392,6 +393,7 @@ pub fn intersect<K: TriangleKernel>(ray: &Ray, tri: &Triangle, cull: Cull) -> Op
 /// Closest hit of ray lanes over a slice of triangles with kernel `K` (N rays × 1 triangle).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest<K: TriangleKernel, L: Lane>(
     rays: &RayPacket<L>,
     tris: &[Triangle],
@@ -406,6 +408,7 @@ pub fn closest<K: TriangleKernel, L: Lane>(
 /// Lanes whose ray hits some triangle (occlusion), with kernel `K`.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any<K: TriangleKernel, L: Lane>(
     rays: &RayPacket<L>,
     tris: &[Triangle],
@@ -419,6 +422,7 @@ pub fn any<K: TriangleKernel, L: Lane>(
 
 /// Every hit: calls `f(index, hit)` for each triangle that some lane hits.
 #[inline]
+#[doc(hidden)]
 pub fn all<K: TriangleKernel, L: Lane>(
     rays: &RayPacket<L>,
     tris: &[Triangle],
@@ -438,6 +442,7 @@ pub fn all<K: TriangleKernel, L: Lane>(
 /// the triangle's position in the slice that was packed.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest_soa<K: TriangleKernel, L: Lane>(
     ray: &Ray,
     tris: &[TrianglePacket<L>],
@@ -450,6 +455,7 @@ pub fn closest_soa<K: TriangleKernel, L: Lane>(
 /// True when one ray hits some triangle packed in lanes.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any_soa<K: TriangleKernel, L: Lane>(
     ray: &Ray,
     tris: &[TrianglePacket<L>],
