@@ -14,9 +14,9 @@
 //! the entry and the exit point when the origin is outside, only the exit when it is inside.
 //! [`surface`] gives the point, the unit outward normal and the squared distance for a root.
 //!
-//! Entry points: [`closest`], [`any`], [`all`] for ray packets over a slice of spheres (N rays ×
-//! 1 sphere), [`closest_soa`] for one ray over spheres stored in lanes (1 ray × N spheres), and
-//! [`intersect`] for one ray and one sphere. The focal caches have the same set in [`focal`].
+//! Ask through [`Query`](crate::Query): `spheres.closest(&ray)` (default kernel [`Robust`]),
+//! `spheres.using::<Geometric>().any(&packet)`; rays from one eye through the focal cache
+//! [`FocalSpheres`](focal::FocalSpheres).
 //!
 //! Bad input: a sphere with a non-finite centre or a radius that is not a finite positive
 //! number is stored with a NaN radius by [`Sphere::new`] and never hit; bad rays are

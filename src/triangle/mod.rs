@@ -44,11 +44,9 @@
 //! (`tests/suite/fuzz.rs`: magnitudes `2^-140…2^127`, special values) checks this on every
 //! case, its former failures kept as regression cases.
 //!
-//! **Entry points.** [`intersect`] (one ray, one triangle), [`closest`], [`any`], [`all`] (ray
-//! packets over a slice of triangles: N rays × 1 triangle) and [`closest_soa`], [`any_soa`]
-//! (one ray over triangles packed in lanes, like Embree's `Triangle4`: 1 ray × N triangles).
-//! Meshes over shared vertex slices are in [`mesh`](crate::mesh); the focal cache has the same
-//! set in [`focal`].
+//! **Asking.** Through [`Query`](crate::Query): `tris.closest(&ray)` (default kernel
+//! [`Watertight`]), `tris.using::<Moller>().any(&packet)`; meshes over shared vertex slices are
+//! in [`mesh`](crate::mesh), with their focal cache [`FocalMesh`](crate::mesh::FocalMesh).
 //!
 //! **Bad input.** [`Triangle::new`] stores a triangle with a non-finite coordinate or exactly
 //! zero area (collinear vertices, decided exactly) with NaN vertices, and every kernel misses
@@ -56,19 +54,17 @@
 //!
 //! ```
 //! use glam::Vec3;
-//! use raylane::triangle::{self, Cull, FocalTriangle, Triangle, Watertight};
-//! use raylane::{Ray, RayPacket};
+//! use raylane::triangle::{Triangle, Watertight};
+//! use raylane::{Query, Ray, RayPacket};
 //!
-//! let tri = Triangle::new(Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0));
+//! let tri = [Triangle::new(Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0))];
 //! let ray = Ray::new(Vec3::new(1.0, 1.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
-//! let hit = triangle::intersect::<Watertight>(&ray, &tri, Cull::None).unwrap();
+//! let hit = tri[..].using::<Watertight>().closest(&ray).unwrap();
 //! assert_eq!((hit.t, hit.u), (5.0, 0.25)); // u weighs B, v weighs C
 //!
-//! // Rays from one eye: cache the triangle once, then 9 mul + 6 add per missing ray.
-//! let cache = [FocalTriangle::new(ray.origin(), &tri)];
-//! let rays = RayPacket::<wide::f32x8>::splat(&ray);
-//! let hits = triangle::focal::closest(&rays, &cache, Cull::Back); // front faces only
-//! assert_eq!(hits.lane(7).unwrap().t, 5.0);
+//! // A packet gets the same record per lane.
+//! let hits = tri[..].closest(&RayPacket::<wide::f32x8>::splat(&ray));
+//! assert_eq!(hits.lane(7), Some(hit));
 //! ```
 
 mod badouel;
