@@ -4,9 +4,9 @@
 //! `t`, two surface parameters `u`, `v` (barycentrics for triangles, zero otherwise) and the
 //! lanes that hit. The loops here run a kernel over a slice of primitives:
 //!
-//! * **N rays × 1 primitive** ([`closest`], [`any`]): the primitive is splatted into every lane
+//! * **N rays × 1 primitive** (`closest`, `any`): the primitive is splatted into every lane
 //!   and the rays' `t_max` shrinks as hits are found, so later primitives must be closer;
-//! * **1 ray × N primitives** ([`closest_soa`], [`any_soa`]): primitives sit in lanes (structure
+//! * **1 ray × N primitives** (`closest_soa`, `any_soa`): primitives sit in lanes (structure
 //!   of arrays), the ray is splatted, and the lanes are reduced at the end.
 //!
 //! Both shapes return the same hit, bit for bit, whatever the order the primitives are visited
@@ -242,7 +242,7 @@ impl Best<f32> {
 /// only closer hits; it returns `None` when no lane can hit (a kernel's early exit), which lets
 /// the miss path skip the merge with the hit path entirely.
 #[inline]
-pub fn closest<L: Lane, P>(
+pub(crate) fn closest<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: impl IntoIterator<Item = P>,
     mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
@@ -264,7 +264,7 @@ pub fn closest<L: Lane, P>(
 
 /// True in lanes where some primitive is hit (occlusion); stops when every valid lane is hit.
 #[inline]
-pub fn any<L: Lane, P>(
+pub(crate) fn any<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: impl IntoIterator<Item = P>,
     mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
@@ -384,7 +384,7 @@ pub(crate) fn any_filtered<L: Lane, P>(
 /// index; primitive `j` of chunk `c` has index `c·L::LANES + j`. Lanes past `count` must miss
 /// (padding), which the primitive packets guarantee.
 #[inline]
-pub fn closest_soa<L: Lane, P>(
+pub(crate) fn closest_soa<L: Lane, P>(
     ray: &Ray,
     chunks: impl IntoIterator<Item = P>,
     mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
@@ -437,7 +437,7 @@ where
 
 /// True when one ray hits some primitive stored in lanes (1 ray × N primitives).
 #[inline]
-pub fn any_soa<L: Lane, P>(
+pub(crate) fn any_soa<L: Lane, P>(
     ray: &Ray,
     chunks: impl IntoIterator<Item = P>,
     mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,

@@ -10,12 +10,6 @@ pub use crate::hit::{Best, HitRecord, LaneHit};
 pub use crate::sphere::focal::FocalLanes;
 pub use crate::triangle::focal::FocalRays;
 
-/// The closest-hit and any-hit loops shared by every primitive (N rays × 1 primitive and
-/// 1 ray × N primitives).
-pub mod hit {
-    pub use crate::hit::{any, any_soa, closest, closest_soa};
-}
-
 /// Sphere entry points below [`Query`](crate::Query): one ray × one sphere, packets × a slice,
 /// one ray × spheres packed in lanes.
 pub mod sphere {
