@@ -4,9 +4,9 @@
 //! `t`, two surface parameters `u`, `v` (barycentrics for triangles, zero otherwise) and the
 //! lanes that hit. The loops here run a kernel over a slice of primitives:
 //!
-//! * **N rays × 1 primitive** ([`closest`], [`any`]): the primitive is splatted into every lane
+//! * **N rays × 1 primitive** (`closest`, `any`): the primitive is splatted into every lane
 //!   and the rays' `t_max` shrinks as hits are found, so later primitives must be closer;
-//! * **1 ray × N primitives** ([`closest_soa`], [`any_soa`]): primitives sit in lanes (structure
+//! * **1 ray × N primitives** (`closest_soa`, `any_soa`): primitives sit in lanes (structure
 //!   of arrays), the ray is splatted, and the lanes are reduced at the end.
 //!
 //! Both shapes return the same hit, bit for bit, whatever the order the primitives are visited
@@ -144,7 +144,7 @@ impl<L: Lane> Best<L> {
     /// No hit in any lane.
     #[inline]
     #[must_use]
-    pub fn none() -> Self {
+    pub fn miss() -> Self {
         let m = LaneHit::<L>::miss();
         Best {
             t: m.t,
@@ -176,7 +176,7 @@ impl<L: Lane> Best<L> {
     #[inline(always)]
     #[must_use]
     pub(crate) fn single(h: &LaneHit<L>, index: u32) -> Self {
-        let mut b = Self::none();
+        let mut b = Self::miss();
         b.take(h, h.mask, index);
         b.finish()
     }
@@ -242,13 +242,13 @@ impl Best<f32> {
 /// only closer hits; it returns `None` when no lane can hit (a kernel's early exit), which lets
 /// the miss path skip the merge with the hit path entirely.
 #[inline]
-pub fn closest<L: Lane, P>(
+pub(crate) fn closest<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: impl IntoIterator<Item = P>,
     mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
 ) -> Best<L> {
     let mut r = *rays;
-    let mut best = Best::none();
+    let mut best = Best::miss();
     for (i, p) in prims.into_iter().enumerate() {
         // `None`: no lane passed the kernel's first test (nothing to merge on the miss path).
         if let Some(h) = test(&r, p) {
@@ -264,7 +264,7 @@ pub fn closest<L: Lane, P>(
 
 /// True in lanes where some primitive is hit (occlusion); stops when every valid lane is hit.
 #[inline]
-pub fn any<L: Lane, P>(
+pub(crate) fn any<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: impl IntoIterator<Item = P>,
     mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
@@ -320,7 +320,7 @@ fn candidates<L: Lane, P>(
 /// One lane takes a single pass ([`closest`]): `test` stops where the first pass would, and
 /// LLVM turns a one-lane first pass into gathers across primitives (4× slower on x86-64).
 #[inline]
-pub fn closest_filtered<L: Lane, P>(
+pub(crate) fn closest_filtered<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: &[P],
     mut candidate: impl FnMut(&RayPacket<L>, &P) -> L::Mask,
@@ -330,7 +330,7 @@ pub fn closest_filtered<L: Lane, P>(
         return closest(rays, prims, test);
     }
     let mut r = *rays;
-    let mut best = Best::none();
+    let mut best = Best::miss();
     for (b, block) in prims.chunks(64).enumerate() {
         let mut bits = candidates(&r, block, &mut candidate);
         while bits != 0 {
@@ -351,7 +351,7 @@ pub fn closest_filtered<L: Lane, P>(
 /// [`any`] in two passes per block of 64 primitives (one lane: a single pass), as
 /// [`closest_filtered`].
 #[inline]
-pub fn any_filtered<L: Lane, P>(
+pub(crate) fn any_filtered<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: &[P],
     mut candidate: impl FnMut(&RayPacket<L>, &P) -> L::Mask,
@@ -384,7 +384,7 @@ pub fn any_filtered<L: Lane, P>(
 /// index; primitive `j` of chunk `c` has index `c·L::LANES + j`. Lanes past `count` must miss
 /// (padding), which the primitive packets guarantee.
 #[inline]
-pub fn closest_soa<L: Lane, P>(
+pub(crate) fn closest_soa<L: Lane, P>(
     ray: &Ray,
     chunks: impl IntoIterator<Item = P>,
     mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
@@ -393,7 +393,7 @@ where
     L::Scalar: Scalar,
 {
     let mut r = RayPacket::<L>::splat(ray);
-    let mut best = Best::<L>::none();
+    let mut best = Best::<L>::miss();
     for (c, p) in chunks.into_iter().enumerate() {
         let Some(h) = test(&r, p) else { continue };
         let take = closer(&h, &best);
@@ -437,7 +437,7 @@ where
 
 /// True when one ray hits some primitive stored in lanes (1 ray × N primitives).
 #[inline]
-pub fn any_soa<L: Lane, P>(
+pub(crate) fn any_soa<L: Lane, P>(
     ray: &Ray,
     chunks: impl IntoIterator<Item = P>,
     mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,

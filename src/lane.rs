@@ -118,7 +118,7 @@ impl Mask for bool {
 ///
 /// Lane-sized scratch arrays (in [`V3::from_fn`](crate::vec3::V3::from_fn),
 /// [`TrianglePacket::from_fn`](crate::triangle::TrianglePacket::from_fn),
-/// [`FocalRays::new`](crate::triangle::FocalRays::new), the vector runner and the demo) have
+/// `FocalRays::new`, the vector runner and the demo) have
 /// this length, and each of them checks `L::LANES <= MAX_LANES` at compile time
 /// ([`assert_fits`]): a wider lane type is a compile error, never a wrong result.
 ///
@@ -190,6 +190,7 @@ pub trait Lane:
     type Mask: Mask;
     /// A single `f64` lane used for rare higher-precision fallbacks of one lane
     /// (`f64` itself, or `Counted<f64>` when counting).
+    #[doc(hidden)]
     type Precise: Lane<Scalar = f64>;
     /// One `u32` per lane, for primitive indices in hit records.
     type Indices: Copy + Debug + PartialEq + AsRef<[u32]> + AsMut<[u32]>;
@@ -226,6 +227,7 @@ pub trait Lane:
     /// Every index set to `v`.
     fn indices(v: u32) -> Self::Indices;
     /// Lane `i` as a single higher-precision lane (exact widening).
+    #[doc(hidden)]
     fn precise_lane(self, i: usize) -> Self::Precise;
 
     /// Builds a lane value from `f32` elements (exact).

@@ -31,21 +31,23 @@
 //! [`lane`] (the abstraction), [`vec3`] (`V3<L>`, SoA vectors), [`ray`] (rays and packets),
 //! [`camera`] (pinhole primary rays from one focal point), [`sphere`], [`plane`], [`triangle`],
 //! [`mesh`] (triangles over shared vertex slices), [`bounds`] (bounding spheres and culling),
-//! [`hit`] (records and the closest/any loops), [`registry`] (the one list of kernels that the
+//! [`query`] (the one way to ask: [`Query`], [`Hit`], [`Hits`]), [`registry`] (the one list of kernels that the
 //! checker, the demo, the benchmarks, the firmware and the op-count report walk), [`opcount`]
 //! (the counting lane), and, behind the `vectors` feature, `vectors` (the test-vector parser,
 //! runner and digest shared by the checker, the tests and the firmware) and behind the `demo`
-//! feature `demo` (the scenes and their renderer). `ARCHITECTURE.md` draws the layers.
+//! feature `demo` (the scenes and their renderer). `ARCHITECTURE.md` draws the layers. The
+//! per-set loops and lane-wise records below the queries are raylane's own (its benches,
+//! firmware and tests reach them through a hidden `internals` module, outside semver).
 //!
 //! ## Example
 //!
 //! ```
 //! use glam::Vec3;
-//! use raylane::{Ray, sphere::{self, Sphere, Robust}};
+//! use raylane::{Query, Ray, sphere::{Sphere, Robust}};
 //!
 //! let ray = Ray::new(Vec3::new(1.0, 0.0, 1.0), Vec3::new(1.0, 2.0, 1.0));
-//! let ball = Sphere::new(Vec3::splat(5.0), 3.0);
-//! let hit = sphere::intersect::<Robust>(&ray, &ball).unwrap();
+//! let ball = [Sphere::new(Vec3::splat(5.0), 3.0)];
+//! let hit = ball[..].using::<Robust>().closest(&ray).unwrap();
 //! assert!((ray.at(hit.t) - Vec3::new(3.0, 4.0, 3.0)).length() < 1e-5);
 //! ```
 
@@ -58,7 +60,10 @@ pub mod bvh;
 pub mod camera;
 #[cfg(feature = "demo")]
 pub mod demo;
+#[doc(hidden)]
 pub mod hit;
+#[doc(hidden)]
+pub mod internals;
 pub mod lane;
 pub mod mesh;
 pub mod opcount;
@@ -79,7 +84,6 @@ pub mod vectors;
 struct ReadmeDoctests;
 
 pub use camera::Pinhole;
-pub use hit::{HitRecord, LaneHit};
 pub use lane::{Lane, Mask};
 pub use query::{Hit, Hits, Query, Rays, Using};
 pub use ray::{Dir, Ray, Ray4, Ray8, Ray16, RayPacket};

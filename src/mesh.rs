@@ -421,7 +421,7 @@ impl<K: TriangleKernel> Query for Using<'_, Mesh<'_>, K> {
     fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
         let (m, cull) = (self.set(), self.cull());
         let Some(r) = m.kept(rays) else {
-            return Hits::none();
+            return Hits::miss();
         };
         let pre = K::prepare(&r);
         let best = hit::closest(&r, 0..m.len(), |r, i| {
@@ -470,14 +470,14 @@ impl Query for Mesh<'_> {
 /// Focal meshes: rays whose origin is not exactly the cache's eye miss (see
 /// [`FocalMesh::eye`]); the others are prepared once ([`FocalRays`]), culled by the bound, and
 /// tested against the entries in index order (two passes per block, as
-/// [`hit::closest_filtered`]). Culling: [`FocalMesh::culled`].
+/// `hit::closest_filtered`). Culling: [`FocalMesh::culled`].
 impl Query for FocalMesh<'_> {
     #[inline]
     fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
         let r = query::at_eye(rays, self.eye);
         let best = self
             .try_closest(&FocalRays::new(&r), self.cull)
-            .unwrap_or_else(Best::none);
+            .unwrap_or_else(Best::miss);
         Hits::from_triangles(&r, &best, self.cull, |i| {
             self.cache.get(i as usize).map(|e| e.triangle())
         })

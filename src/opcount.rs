@@ -369,7 +369,7 @@ impl IntoIterator for Table {
 /// (2,0,0) of edge AB (the exact fallbacks, both hits: the watertight kernel's `f64` edge
 /// functions are counted, the focal kernel's exact predicate is not), and `per ray` the setup
 /// a query does once per ray (where there is any: [`Shear::new`](crate::triangle::Shear::new),
-/// [`FocalRays::new`](crate::triangle::FocalRays::new)). The precomputed methods are counted
+/// `FocalRays::new`). The precomputed methods are counted
 /// as their [`TriangleKernel`](crate::triangle::TriangleKernel) runs them, precomputing on
 /// the fly (the study separates the two). Besides the kernels: `geometric-prepared` (the
 /// geometric test with `T` and `c²` prepared per eye), `sphere-point` and `sphere-surface`
@@ -404,9 +404,8 @@ mod examples {
     use crate::sphere::focal::FocalKernel;
     use crate::sphere::{self as sp, FocalSphere, Geometric, SphereKernel, SpherePacket};
     use crate::triangle::focal as tf;
-    use crate::triangle::{
-        Cull, FocalRays, FocalTriangle, Triangle, TriangleKernel, TrianglePacket,
-    };
+    use crate::triangle::focal::FocalRays;
+    use crate::triangle::{Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
 
     type C = Counted<f32>;
 

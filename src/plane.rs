@@ -83,6 +83,7 @@ impl<L: Lane> PlanePacket<L> {
 /// The ray–plane test: `t = ((a − o)·n)/(d·n)` inside the ray's interval.
 #[inline(always)]
 #[must_use]
+#[doc(hidden)]
 pub fn intersect_lanes<L: Lane>(ray: &RayPacket<L>, p: &PlanePacket<L>) -> LaneHit<L> {
     // 1. Numerator: signed distance of the origin, scaled by |n|.
     let num = (p.point - ray.origin).dot(p.normal);
@@ -94,6 +95,7 @@ pub fn intersect_lanes<L: Lane>(ray: &RayPacket<L>, p: &PlanePacket<L>) -> LaneH
 /// (3 mul, 2 add, 1 div, 2 cmp), with the numerator `num = (a − E)·n` given per lane.
 #[inline(always)]
 #[must_use]
+#[doc(hidden)]
 pub fn focal_lanes<L: Lane>(ray: &RayPacket<L>, num: L, normal: V3<L>) -> LaneHit<L> {
     // Denominator; parallel rays give t = ±inf or NaN, which fails the interval test.
     let den = ray.dir.dot(normal);
@@ -141,6 +143,7 @@ impl FocalPlane {
 /// Closest hit of one ray and one plane.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn intersect(ray: &Ray, plane: &Plane) -> Option<HitRecord> {
     intersect_lanes(&RayPacket::<f32>::splat(ray), &PlanePacket::splat(plane)).record()
 }
@@ -148,6 +151,7 @@ pub fn intersect(ray: &Ray, plane: &Plane) -> Option<HitRecord> {
 /// Closest hit of ray lanes over a slice of planes (N rays × 1 plane).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest<L: Lane>(rays: &RayPacket<L>, planes: &[Plane]) -> hit::Best<L> {
     hit::closest(rays, planes, |r, p| {
         Some(intersect_lanes(r, &PlanePacket::splat(p)))
@@ -157,6 +161,7 @@ pub fn closest<L: Lane>(rays: &RayPacket<L>, planes: &[Plane]) -> hit::Best<L> {
 /// Lanes whose ray hits some plane (occlusion).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any<L: Lane>(rays: &RayPacket<L>, planes: &[Plane]) -> L::Mask {
     hit::any(rays, planes, |r, p| {
         Some(intersect_lanes(r, &PlanePacket::splat(p)))
@@ -165,6 +170,7 @@ pub fn any<L: Lane>(rays: &RayPacket<L>, planes: &[Plane]) -> L::Mask {
 
 /// Every plane some lane hits: `f(index, hit)` (a plane is crossed at most once).
 #[inline]
+#[doc(hidden)]
 pub fn all<L: Lane>(rays: &RayPacket<L>, planes: &[Plane], mut f: impl FnMut(u32, &LaneHit<L>)) {
     for (i, p) in planes.iter().enumerate() {
         let h = intersect_lanes(rays, &PlanePacket::splat(p));
@@ -177,6 +183,7 @@ pub fn all<L: Lane>(rays: &RayPacket<L>, planes: &[Plane], mut f: impl FnMut(u32
 /// Closest hit of ray lanes from the eye over cached planes.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest_focal<L: Lane>(rays: &RayPacket<L>, cache: &[FocalPlane]) -> hit::Best<L> {
     hit::closest(rays, cache, |r, p| Some(p.intersect_lanes(r)))
 }
@@ -184,6 +191,7 @@ pub fn closest_focal<L: Lane>(rays: &RayPacket<L>, cache: &[FocalPlane]) -> hit:
 /// Closest hit of one ray over planes packed in lanes (1 ray × N planes).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest_soa<L: Lane>(ray: &Ray, planes: &[PlanePacket<L>]) -> Option<HitRecord> {
     hit::closest_soa(ray, planes, |r, p| Some(intersect_lanes(r, p)))
 }

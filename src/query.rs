@@ -127,7 +127,7 @@ impl<L: Lane> Hits<L> {
     /// No lane hits.
     #[inline]
     #[must_use]
-    pub fn none() -> Self {
+    pub fn miss() -> Self {
         let zero = L::from_f32(0.0);
         let z = V3::new(zero, zero, zero);
         Hits {
@@ -219,7 +219,7 @@ impl<L: Lane> Hits<L> {
         sphere: impl Fn(u32) -> Option<Sphere>,
     ) -> Self {
         if best.mask.none() {
-            return Self::none();
+            return Self::miss();
         }
         let get = |i: usize| {
             winner(best, i)
@@ -255,7 +255,7 @@ impl<L: Lane> Hits<L> {
         tri: impl Fn(u32) -> Option<Triangle>,
     ) -> Self {
         if best.mask.none() {
-            return Self::none();
+            return Self::miss();
         }
         let p = TrianglePacket::<L>::from_fn(|i| {
             winner(best, i).and_then(&tri).unwrap_or(Triangle::never())
@@ -287,7 +287,7 @@ impl<L: Lane> Hits<L> {
         plane: impl Fn(u32) -> Option<Plane>,
     ) -> Self {
         if best.mask.none() {
-            return Self::none();
+            return Self::miss();
         }
         let normal = V3::<L>::from_fn(|i| {
             winner(best, i)
@@ -836,7 +836,7 @@ macro_rules! scene {
         impl<$($q: Query),+> Query for ($($q,)+) {
             #[inline]
             fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
-                let mut best = Hits::<L>::none();
+                let mut best = Hits::<L>::miss();
                 $(
                     let r = rays.shrink(best.mask, hit::relax(best.t));
                     best.merge(&self.$i.closest_packet(&r).with_set($i));

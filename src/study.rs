@@ -33,9 +33,10 @@ use crate::sphere::{
     self, EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust,
     SphereKernel, SpherePacket,
 };
+use crate::triangle::focal::FocalRays;
 use crate::triangle::{
-    Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout, KenslerShirley,
-    Moller, Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
+    Badouel, BaldwinWeber, Cramer, Cull, FocalTriangle, HavelHerout, KenslerShirley, Moller,
+    Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
     focal as tf,
 };
 
@@ -518,7 +519,7 @@ pub fn repeat<L: Lane<Scalar = f32>>(index: usize, path: Path, n: usize) -> Opti
             let ray = triangle_rays()[usize::from(hit)];
             let rp = black_box(RayPacket::<L>::splat(&ray));
             let tp = TrianglePacket::<L>::splat(&triangle());
-            let lane_hits = |h: &crate::LaneHit<L>| h.mask.bits().count_ones();
+            let lane_hits = |h: &crate::hit::LaneHit<L>| h.mask.bits().count_ones();
             fn plain<K: TriangleKernel, L: Lane<Scalar = f32>>(
                 n: usize,
                 rp: &RayPacket<L>,

@@ -35,9 +35,8 @@ use crate::ray::RayPacket;
 use crate::registry::{Kernel, Visitor};
 use crate::sphere::focal::FocalKernel;
 use crate::sphere::{FocalSphere, Roots, Sphere, SphereKernel, SpherePacket};
-use crate::triangle::{
-    self, Cull, FocalRays, FocalTriangle, Triangle, TriangleKernel, TrianglePacket,
-};
+use crate::triangle::focal::FocalRays;
+use crate::triangle::{self, Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
 use crate::vec3::V3;
 
 /// Relative tolerance on `t`.

@@ -18,8 +18,9 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use raylane::bvh::{self, Bvh, Leaf, Node, Primitives, Scratch, Sphere4, Tri4};
+use raylane::internals;
 use raylane::mesh::{FocalMesh, Mesh};
-use raylane::sphere::{self, Robust, Sphere};
+use raylane::sphere::{Robust, Sphere};
 use raylane::{Lane, Mask, Query, Ray, RayPacket};
 
 use crate::meshes::Answers;
@@ -138,7 +139,7 @@ pub fn spheres_closest<L: Lane<Scalar = f32>>(
 ) -> u32 {
     let mut n = 0;
     for p in packets {
-        let h = sphere::closest::<Robust, L>(black_box(p), spheres);
+        let h = internals::sphere::closest::<Robust, L>(black_box(p), spheres);
         n += h.mask.bits().count_ones();
         if let Some(o) = out.as_deref_mut() {
             o.extend((0..L::LANES).map(|i| h.lane(i).map(|r| (r.t, r.index))));

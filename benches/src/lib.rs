@@ -15,13 +15,14 @@
 use std::hint::black_box;
 
 use glam::Vec3;
-use raylane::hit::Best;
-use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
+use raylane::internals;
+use raylane::internals::Best;
+use raylane::internals::HitRecord;
+use raylane::plane::{FocalPlane, Plane, PlanePacket};
 use raylane::sphere::focal::{self as sf, FocalKernel};
-use raylane::sphere::{self, FocalSphere, Sphere, SphereKernel, SpherePacket};
-use raylane::triangle::focal as tf;
-use raylane::triangle::{self, Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
-use raylane::{HitRecord, Lane, Mask, Pinhole, Ray, RayPacket};
+use raylane::sphere::{FocalSphere, Sphere, SphereKernel, SpherePacket};
+use raylane::triangle::{Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
+use raylane::{Lane, Mask, Pinhole, Ray, RayPacket};
 
 pub mod bvh_raylane;
 pub mod meshes;
@@ -88,7 +89,7 @@ pub fn guard_frame<K: sf::FocalKernel>(
     packets
         .iter()
         .map(|p| {
-            sf::closest::<K, _>(black_box(p), cache)
+            internals::sphere::focal::closest::<K, _>(black_box(p), cache)
                 .mask
                 .bits()
                 .count_ones()
@@ -427,8 +428,8 @@ impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane::registry::Visitor for Que
     fn sphere<K: SphereKernel>(self, _: Kernel) -> B::Output {
         let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
         self.body.run(
-            |r| sphere::closest::<K, _>(r, &f.spheres[..u]),
-            |r| sphere::closest_soa::<K, _>(r, &l.spheres),
+            |r| internals::sphere::closest::<K, _>(r, &f.spheres[..u]),
+            |r| internals::sphere::closest_soa::<K, _>(r, &l.spheres),
         )
     }
 
@@ -440,16 +441,16 @@ impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane::registry::Visitor for Que
             (&f.unguarded, &l.unguarded)
         };
         self.body.run(
-            |r| sf::closest::<K, _>(r, &cache[..u]),
-            |r| sf::closest_soa::<K, _>(r, packed),
+            |r| internals::sphere::focal::closest::<K, _>(r, &cache[..u]),
+            |r| internals::sphere::focal::closest_soa::<K, _>(r, packed),
         )
     }
 
     fn plane(self, _: Kernel) -> B::Output {
         let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
         self.body.run(
-            |r| plane::closest(r, &f.planes[..u]),
-            |r| plane::closest_soa(r, &l.planes),
+            |r| internals::plane::closest(r, &f.planes[..u]),
+            |r| internals::plane::closest_soa(r, &l.planes),
         )
     }
 
@@ -457,24 +458,27 @@ impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane::registry::Visitor for Que
         let (f, u) = (self.frame, self.lanes.used);
         // No 1 ray × N shape: the packet query of the ray splatted (not run).
         self.body.run(
-            |r| plane::closest_focal(r, &f.focal_planes[..u]),
-            |r| plane::closest_focal(&RayPacket::<f32>::splat(r), &f.focal_planes[..u]).lane(0),
+            |r| internals::plane::closest_focal(r, &f.focal_planes[..u]),
+            |r| {
+                internals::plane::closest_focal(&RayPacket::<f32>::splat(r), &f.focal_planes[..u])
+                    .lane(0)
+            },
         )
     }
 
     fn triangle<K: TriangleKernel>(self, _: Kernel) -> B::Output {
         let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
         self.body.run(
-            |r| triangle::closest::<K, _>(r, &f.tris[..u], Cull::None),
-            |r| triangle::closest_soa::<K, _>(r, &l.tris, Cull::None),
+            |r| internals::triangle::closest::<K, _>(r, &f.tris[..u], Cull::None),
+            |r| internals::triangle::closest_soa::<K, _>(r, &l.tris, Cull::None),
         )
     }
 
     fn focal_triangle(self, _: Kernel) -> B::Output {
         let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
         self.body.run(
-            |r| tf::closest(r, &f.focal_tris[..u], Cull::None),
-            |r| tf::closest_soa(r, &l.focal_tris, Cull::None),
+            |r| internals::triangle::focal::closest(r, &f.focal_tris[..u], Cull::None),
+            |r| internals::triangle::focal::closest_soa(r, &l.focal_tris, Cull::None),
         )
     }
 }

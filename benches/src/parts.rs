@@ -130,7 +130,7 @@ fn split(
 /// The closest hit of one packet of rays from the meshes' eye over every part.
 #[inline(always)]
 fn closest<L: Lane>(rays: &RayPacket<L>, meshes: &[FocalMesh]) -> Hits<L> {
-    let mut best = Hits::<L>::none();
+    let mut best = Hits::<L>::miss();
     for m in meshes {
         // The bounding sphere first, then the triangles; ties keep the earlier part.
         best.merge(&m.closest(rays));

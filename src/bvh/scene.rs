@@ -336,7 +336,7 @@ impl<'s, P: Leaf> Scene<'s, P> {
 /// traversal order.
 impl<P: Leaf> Query for Scene<'_, P> {
     fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
-        let mut out = Hits::<L>::none();
+        let mut out = Hits::<L>::miss();
         for j in 0..L::LANES {
             if let Some(h) = lane_ray(rays, j).and_then(|r| self.closest_one(&r)) {
                 put_lane_generic(&mut out, j, &h);
@@ -360,7 +360,7 @@ impl<P: Leaf> Query for Scene<'_, P> {
             let Some(r) = lane_ray(rays, j) else { continue };
             self.each_instance(&r, &mut |inst, i, local| {
                 object_all(self, inst, i, &r, local, &mut |h: &Hit| {
-                    let mut out = Hits::<L>::none();
+                    let mut out = Hits::<L>::miss();
                     put_lane_generic(&mut out, j, h);
                     f(&out);
                 });

@@ -406,7 +406,7 @@ impl<P: Leaf> Bvh<'_, P> {
     ) -> (Best<L>, [u32; MAX_LANES]) {
         crate::lane::assert_fits::<L>();
         let valid = rays.valid();
-        let mut best = Best::<L>::none();
+        let mut best = Best::<L>::miss();
         let mut win = [0u32; MAX_LANES];
         if valid.none() {
             return (best, win);

@@ -10,7 +10,8 @@ use crate::ray::RayPacket;
 use crate::registry::{Kernel, Visitor};
 use crate::sphere::focal::{self as sf, FocalKernel};
 use crate::sphere::{self, FocalSphere, Sphere, SphereKernel};
-use crate::triangle::{Cull, FocalRays, TriangleKernel, Watertight};
+use crate::triangle::focal::FocalRays;
+use crate::triangle::{Cull, TriangleKernel, Watertight};
 
 /// What is hit in each lane of a packet, merged over the kinds of primitive.
 #[derive(Clone, Copy, Debug)]
@@ -192,7 +193,7 @@ impl Frame<'_> {
         rays: &RayPacket<L>,
         guarded: bool,
     ) -> hit::Best<L> {
-        let mut best = hit::Best::<L>::none();
+        let mut best = hit::Best::<L>::miss();
         crate::lane::assert_fits::<L>();
         let mut entries = [empty_sphere(); MAX_LANES];
         for (j, s) in self.scene.spheres.iter().enumerate() {
@@ -244,16 +245,16 @@ impl<L: Lane<Scalar = f32>> Visitor for SphereHits<'_, '_, L> {
 
     // Not sphere kernels: `Frame::new` refuses them.
     fn plane(self, _: Kernel) -> hit::Best<L> {
-        hit::Best::none()
+        hit::Best::miss()
     }
     fn focal_plane(self, _: Kernel) -> hit::Best<L> {
-        hit::Best::none()
+        hit::Best::miss()
     }
     fn triangle<K: TriangleKernel>(self, _: Kernel) -> hit::Best<L> {
-        hit::Best::none()
+        hit::Best::miss()
     }
     fn focal_triangle(self, _: Kernel) -> hit::Best<L> {
-        hit::Best::none()
+        hit::Best::miss()
     }
 }
 

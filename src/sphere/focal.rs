@@ -334,6 +334,7 @@ impl<L: Lane> FocalSphere<L> {
 /// Where a focal kernel reads its cached sphere lanes from: a [`FocalSphere<L>`] already in
 /// lanes (1 ray × N spheres), or a [`Splat`] of one entry (N rays × 1 sphere) that broadcasts
 /// only what each step needs, so a miss touches `T` and `k_lo` alone.
+#[doc(hidden)]
 pub trait FocalLanes<L: Lane> {
     /// `T = C − E` in lanes.
     fn t(&self) -> V3<L>;
@@ -369,6 +370,7 @@ impl<L: Lane> FocalLanes<L> for FocalSphere<L> {
 
 /// One cache entry seen in every lane, broadcast lazily (see [`FocalLanes`]).
 #[derive(Clone, Copy, Debug)]
+#[doc(hidden)]
 pub struct Splat<'a>(pub &'a FocalSphere<f32>);
 
 impl<L: Lane> FocalLanes<L> for Splat<'_> {
@@ -401,6 +403,7 @@ impl<L: Lane> FocalLanes<L> for Splat<'_> {
 
 /// Builds the guarded cache of `spheres` for rays from `eye` into `out` (no allocation);
 /// returns the number of entries written (`min(spheres.len(), out.len())`).
+#[doc(hidden)]
 pub fn focus(eye: Vec3, spheres: &[Sphere], out: &mut [FocalSphere<f32>]) -> usize {
     let mut n = 0;
     for (s, slot) in spheres.iter().zip(out.iter_mut()) {
@@ -515,6 +518,7 @@ fn hit_path<L: Lane, S: FocalLanes<L>>(
 /// Closest hit of ray packets from the cache's eye over cached spheres (N rays × 1 sphere).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest<K: FocalKernel, L: Lane>(
     rays: &RayPacket<L>,
     cache: &[FocalSphere<f32>],
@@ -530,6 +534,7 @@ pub fn closest<K: FocalKernel, L: Lane>(
 /// Lanes whose ray hits some cached sphere (occlusion).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any<K: FocalKernel, L: Lane>(rays: &RayPacket<L>, cache: &[FocalSphere<f32>]) -> L::Mask {
     hit::any_filtered(
         rays,
@@ -541,6 +546,7 @@ pub fn any<K: FocalKernel, L: Lane>(rays: &RayPacket<L>, cache: &[FocalSphere<f3
 
 /// Every root of every cached sphere some lane hits: `f(index, roots)`.
 #[inline]
+#[doc(hidden)]
 pub fn all<K: FocalKernel, L: Lane>(
     rays: &RayPacket<L>,
     cache: &[FocalSphere<f32>],
@@ -557,6 +563,7 @@ pub fn all<K: FocalKernel, L: Lane>(
 /// Closest hit of one ray from the eye over cached spheres packed in lanes (1 ray × N).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest_soa<K: FocalKernel, L: Lane>(
     ray: &Ray,
     cache: &[FocalSphere<L>],
@@ -567,6 +574,7 @@ pub fn closest_soa<K: FocalKernel, L: Lane>(
 /// True when one ray from the eye hits some cached sphere packed in lanes.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any_soa<K: FocalKernel, L: Lane>(ray: &Ray, cache: &[FocalSphere<L>]) -> bool {
     hit::any_soa(ray, cache, |r, e| K::maybe_roots(r, e).map(|r| r.first()))
 }

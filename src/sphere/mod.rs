@@ -14,9 +14,9 @@
 //! the entry and the exit point when the origin is outside, only the exit when it is inside.
 //! [`surface`] gives the point, the unit outward normal and the squared distance for a root.
 //!
-//! Entry points: [`closest`], [`any`], [`all`] for ray packets over a slice of spheres (N rays ×
-//! 1 sphere), [`closest_soa`] for one ray over spheres stored in lanes (1 ray × N spheres), and
-//! [`intersect`] for one ray and one sphere. The focal caches have the same set in [`focal`].
+//! Ask through [`Query`](crate::Query): `spheres.closest(&ray)` (default kernel [`Robust`]),
+//! `spheres.using::<Geometric>().any(&packet)`; rays from one eye through the focal cache
+//! [`FocalSpheres`](focal::FocalSpheres).
 //!
 //! Bad input: a sphere with a non-finite centre or a radius that is not a finite positive
 //! number is stored with a NaN radius by [`Sphere::new`] and never hit; bad rays are
@@ -172,7 +172,7 @@ impl<L: Lane> SpherePacket<L> {
     /// Lane `i` as a single higher-precision sphere (exact widening; for fallbacks).
     #[inline]
     #[must_use]
-    pub fn precise_lane(&self, i: usize) -> SpherePacket<L::Precise> {
+    pub(crate) fn precise_lane(&self, i: usize) -> SpherePacket<L::Precise> {
         SpherePacket {
             center: self.center.precise_lane(i),
             radius: self.radius.precise_lane(i),
@@ -467,6 +467,7 @@ fn precise_normals<L: Lane>(
 /// inside the ray's interval (its `t`; `u = v = 0` for spheres), or `None` for a miss.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn intersect<K: SphereKernel>(ray: &Ray, sphere: &Sphere) -> Option<HitRecord> {
     K::roots(&RayPacket::<f32>::splat(ray), &SpherePacket::splat(sphere))
         .first()
@@ -476,6 +477,7 @@ pub fn intersect<K: SphereKernel>(ray: &Ray, sphere: &Sphere) -> Option<HitRecor
 /// Closest hit of ray lanes over a slice of spheres with kernel `K` (N rays × 1 sphere).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) -> hit::Best<L> {
     hit::closest(rays, spheres, |r, s| {
         Some(K::roots(r, &SpherePacket::splat(s)).first())
@@ -485,6 +487,7 @@ pub fn closest<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]
 /// Lanes whose ray hits some sphere (occlusion), with kernel `K`.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) -> L::Mask {
     hit::any(rays, spheres, |r, s| {
         Some(K::roots(r, &SpherePacket::splat(s)).first())
@@ -493,6 +496,7 @@ pub fn any<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) ->
 
 /// Every root of every sphere: calls `f(index, roots)` for each sphere that some lane hits.
 #[inline]
+#[doc(hidden)]
 pub fn all<K: SphereKernel, L: Lane>(
     rays: &RayPacket<L>,
     spheres: &[Sphere],
@@ -510,6 +514,7 @@ pub fn all<K: SphereKernel, L: Lane>(
 /// sphere's position in the slice that was packed.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest_soa<K: SphereKernel, L: Lane>(
     ray: &Ray,
     spheres: &[SpherePacket<L>],
@@ -520,6 +525,7 @@ pub fn closest_soa<K: SphereKernel, L: Lane>(
 /// True when one ray hits some sphere packed in lanes.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any_soa<K: SphereKernel, L: Lane>(ray: &Ray, spheres: &[SpherePacket<L>]) -> bool {
     hit::any_soa(ray, spheres, |r, s| Some(K::roots(r, s).first()))
 }

@@ -454,6 +454,7 @@ impl<L: Lane> FocalTriangleLanes<L> for Splat<'_> {
 
 /// Builds the cache of `tris` for rays from `eye` into `out` (no allocation); returns the
 /// number of entries written (`min(tris.len(), out.len())`).
+#[doc(hidden)]
 pub fn focus(eye: Vec3, tris: &[Triangle], out: &mut [FocalTriangle<f32>]) -> usize {
     let mut n = 0;
     for (t, slot) in tris.iter().zip(out.iter_mut()) {
@@ -468,6 +469,7 @@ pub fn focus(eye: Vec3, tris: &[Triangle], out: &mut [FocalTriangle<f32>]) -> us
 /// strictly inside it comes back as a finite `t·s` strictly inside the ray's own interval),
 /// and a unit direction for bounding spheres ([`FocalSphere`](crate::sphere::FocalSphere)).
 #[derive(Clone, Copy, Debug)]
+#[doc(hidden)]
 pub struct FocalRays<L: Lane> {
     pub(crate) scaled: RayPacket<L>,
     pub(crate) scale: L,
@@ -565,7 +567,7 @@ impl<L: Lane> FocalRays<L> {
     /// The scaled rays (the kernel's units).
     #[inline]
     #[must_use]
-    pub fn scaled(&self) -> &RayPacket<L> {
+    pub(crate) fn scaled(&self) -> &RayPacket<L> {
         &self.scaled
     }
 
@@ -586,7 +588,7 @@ impl<L: Lane> FocalRays<L> {
     /// Rays for bounding spheres: from the eye along the unit directions, over `(−inf, +inf)`.
     #[inline]
     #[must_use]
-    pub fn unit_lines(&self) -> RayPacket<L> {
+    pub(crate) fn unit_lines(&self) -> RayPacket<L> {
         RayPacket {
             origin: self.scaled.origin,
             dir: self.unit,
@@ -598,7 +600,7 @@ impl<L: Lane> FocalRays<L> {
     /// Converts a hit from the scaled units to the rays' own (1 mul, and 1 add for `+0`).
     #[inline(always)]
     #[must_use]
-    pub fn unscale(&self, h: LaneHit<L>) -> LaneHit<L> {
+    pub(crate) fn unscale(&self, h: LaneHit<L>) -> LaneHit<L> {
         LaneHit {
             t: own_units(h.t, self.scale),
             ..h
@@ -794,6 +796,7 @@ fn exact_signs<L: Lane, F: FocalTriangleLanes<L>>(
 /// The hit of prepared ray lanes on cached triangle lanes, `t` in the rays' own units.
 #[inline(always)]
 #[must_use]
+#[doc(hidden)]
 pub fn intersect_lanes<L: Lane>(
     rays: &FocalRays<L>,
     tri: &FocalTriangle<L>,
@@ -805,6 +808,7 @@ pub fn intersect_lanes<L: Lane>(
 /// The hit of one ray from the eye on one cached triangle, or `None`.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn intersect(ray: &Ray, tri: &FocalTriangle<f32>, cull: Cull) -> Option<HitRecord> {
     intersect_lanes(&FocalRays::new(&RayPacket::splat(ray)), tri, cull).record()
 }
@@ -812,7 +816,7 @@ pub fn intersect(ray: &Ray, tri: &FocalTriangle<f32>, cull: Cull) -> Option<HitR
 /// Closest hit of prepared rays over cached triangles (N rays × 1 triangle).
 #[inline]
 #[must_use]
-pub fn closest_prepared<L: Lane>(
+pub(crate) fn closest_prepared<L: Lane>(
     rays: &FocalRays<L>,
     cache: &[FocalTriangle<f32>],
     cull: Cull,
@@ -831,6 +835,7 @@ pub fn closest_prepared<L: Lane>(
 /// Closest hit of ray packets from the cache's eye over cached triangles (N rays × 1).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull: Cull) -> Best<L> {
     closest_prepared(&FocalRays::new(rays), cache, cull)
 }
@@ -838,6 +843,7 @@ pub fn closest<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull:
 /// Lanes whose ray hits some cached triangle (occlusion).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull: Cull) -> L::Mask {
     let fr = FocalRays::new(rays);
     hit::any(&fr.scaled, cache, |r, e| maybe_hit(r, &Splat(e), cull))
@@ -846,7 +852,7 @@ pub fn any<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull: Cul
 /// Every hit of prepared rays: `f(index, hit)` for each cached triangle some lane hits (`t` in
 /// the rays' own units).
 #[inline]
-pub fn all_prepared<L: Lane>(
+pub(crate) fn all_prepared<L: Lane>(
     rays: &FocalRays<L>,
     cache: &[FocalTriangle<f32>],
     cull: Cull,
@@ -862,6 +868,7 @@ pub fn all_prepared<L: Lane>(
 
 /// Every hit: `f(index, hit)` for each cached triangle some lane hits.
 #[inline]
+#[doc(hidden)]
 pub fn all<L: Lane>(
     rays: &RayPacket<L>,
     cache: &[FocalTriangle<f32>],
@@ -880,6 +887,7 @@ fn scaled_ray(ray: &Ray) -> (Ray, f32) {
 /// Closest hit of one ray from the eye over cached triangles packed in lanes (1 ray × N).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest_soa<L: Lane>(
     ray: &Ray,
     cache: &[FocalTriangle<L>],
@@ -895,6 +903,7 @@ pub fn closest_soa<L: Lane>(
 /// True when one ray from the eye hits some cached triangle packed in lanes.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any_soa<L: Lane>(ray: &Ray, cache: &[FocalTriangle<L>], cull: Cull) -> bool {
     let (r, _) = scaled_ray(ray);
     hit::any_soa(&r, cache, |r, e| maybe_hit(r, e, cull))

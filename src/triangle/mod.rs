@@ -44,11 +44,9 @@
 //! (`tests/suite/fuzz.rs`: magnitudes `2^-140…2^127`, special values) checks this on every
 //! case, its former failures kept as regression cases.
 //!
-//! **Entry points.** [`intersect`] (one ray, one triangle), [`closest`], [`any`], [`all`] (ray
-//! packets over a slice of triangles: N rays × 1 triangle) and [`closest_soa`], [`any_soa`]
-//! (one ray over triangles packed in lanes, like Embree's `Triangle4`: 1 ray × N triangles).
-//! Meshes over shared vertex slices are in [`mesh`](crate::mesh); the focal cache has the same
-//! set in [`focal`].
+//! **Asking.** Through [`Query`](crate::Query): `tris.closest(&ray)` (default kernel
+//! [`Watertight`]), `tris.using::<Moller>().any(&packet)`; meshes over shared vertex slices are
+//! in [`mesh`](crate::mesh), with their focal cache [`FocalMesh`](crate::mesh::FocalMesh).
 //!
 //! **Bad input.** [`Triangle::new`] stores a triangle with a non-finite coordinate or exactly
 //! zero area (collinear vertices, decided exactly) with NaN vertices, and every kernel misses
@@ -56,19 +54,17 @@
 //!
 //! ```
 //! use glam::Vec3;
-//! use raylane::triangle::{self, Cull, FocalTriangle, Triangle, Watertight};
-//! use raylane::{Ray, RayPacket};
+//! use raylane::triangle::{Triangle, Watertight};
+//! use raylane::{Query, Ray, RayPacket};
 //!
-//! let tri = Triangle::new(Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0));
+//! let tri = [Triangle::new(Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0))];
 //! let ray = Ray::new(Vec3::new(1.0, 1.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
-//! let hit = triangle::intersect::<Watertight>(&ray, &tri, Cull::None).unwrap();
+//! let hit = tri[..].using::<Watertight>().closest(&ray).unwrap();
 //! assert_eq!((hit.t, hit.u), (5.0, 0.25)); // u weighs B, v weighs C
 //!
-//! // Rays from one eye: cache the triangle once, then 9 mul + 6 add per missing ray.
-//! let cache = [FocalTriangle::new(ray.origin(), &tri)];
-//! let rays = RayPacket::<wide::f32x8>::splat(&ray);
-//! let hits = triangle::focal::closest(&rays, &cache, Cull::Back); // front faces only
-//! assert_eq!(hits.lane(7).unwrap().t, 5.0);
+//! // A packet gets the same record per lane.
+//! let hits = tri[..].closest(&RayPacket::<wide::f32x8>::splat(&ray));
+//! assert_eq!(hits.lane(7), Some(hit));
 //! ```
 
 mod badouel;
@@ -87,7 +83,7 @@ mod watertight;
 pub use badouel::{Badouel, BadouelRecord};
 pub use baldwin::{AffineRecord, BaldwinWeber};
 pub use cramer::Cramer;
-pub use focal::{FocalRays, FocalTriangle};
+pub use focal::FocalTriangle;
 pub use havel::{HavelHerout, PlanesRecord};
 pub use kensler::KenslerShirley;
 pub use moller::Moller;
@@ -384,6 +380,7 @@ pub(crate) fn within<L: Lane>(
 /// The hit of one ray on one triangle with kernel `K`, or `None`.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn intersect<K: TriangleKernel>(ray: &Ray, tri: &Triangle, cull: Cull) -> Option<HitRecord> {
     let r = RayPacket::<f32>::splat(ray);
     K::intersect(&r, &K::prepare(&r), &TrianglePacket::splat(tri), cull)
@@ -394,6 +391,7 @@ pub fn intersect<K: TriangleKernel>(ray: &Ray, tri: &Triangle, cull: Cull) -> Op
 /// Closest hit of ray lanes over a slice of triangles with kernel `K` (N rays × 1 triangle).
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest<K: TriangleKernel, L: Lane>(
     rays: &RayPacket<L>,
     tris: &[Triangle],
@@ -408,6 +406,7 @@ pub fn closest<K: TriangleKernel, L: Lane>(
 /// Lanes whose ray hits some triangle (occlusion), with kernel `K`.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any<K: TriangleKernel, L: Lane>(
     rays: &RayPacket<L>,
     tris: &[Triangle],
@@ -421,6 +420,7 @@ pub fn any<K: TriangleKernel, L: Lane>(
 
 /// Every hit: calls `f(index, hit)` for each triangle that some lane hits.
 #[inline]
+#[doc(hidden)]
 pub fn all<K: TriangleKernel, L: Lane>(
     rays: &RayPacket<L>,
     tris: &[Triangle],
@@ -440,6 +440,7 @@ pub fn all<K: TriangleKernel, L: Lane>(
 /// the triangle's position in the slice that was packed.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn closest_soa<K: TriangleKernel, L: Lane>(
     ray: &Ray,
     tris: &[TrianglePacket<L>],
@@ -452,6 +453,7 @@ pub fn closest_soa<K: TriangleKernel, L: Lane>(
 /// True when one ray hits some triangle packed in lanes.
 #[inline]
 #[must_use]
+#[doc(hidden)]
 pub fn any_soa<K: TriangleKernel, L: Lane>(
     ray: &Ray,
     tris: &[TrianglePacket<L>],

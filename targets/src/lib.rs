@@ -12,12 +12,13 @@
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use glam::Vec3;
-use raylane::hit::Best;
+use raylane::internals;
+use raylane::internals::Best;
 use raylane::mesh::Mesh;
-use raylane::plane::{self, FocalPlane, Plane};
+use raylane::plane::{FocalPlane, Plane};
 use raylane::registry::{Kernel, Visitor};
-use raylane::sphere::focal::{self as sf, Focal, FocalKernel};
-use raylane::sphere::{self, FocalSphere, Robust, Sphere, SphereKernel, SpherePacket};
+use raylane::sphere::focal::{Focal, FocalKernel};
+use raylane::sphere::{FocalSphere, Robust, Sphere, SphereKernel, SpherePacket};
 use raylane::triangle::{
     self, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket, Watertight,
 };
@@ -154,7 +155,7 @@ fn query_hits<L: Lane<Scalar = f32>>(h: &raylane::Hits<L>) {
     sink(h.mask.bits() ^ h.t.lane(0).to_bits() ^ h.normal.x.lane(0).to_bits());
 }
 
-fn rec(r: Option<raylane::HitRecord>) {
+fn rec(r: Option<raylane::internals::HitRecord>) {
     sink(r.map_or(7, |h| h.t.to_bits() ^ h.index));
 }
 
@@ -171,7 +172,7 @@ struct Closest<'a, L: Lane> {
 impl<L: Lane<Scalar = f32>> Visitor for Closest<'_, L> {
     type Output = ();
     fn sphere<K: SphereKernel>(self, _: Kernel) {
-        hits(&sphere::closest::<K, L>(self.rays, self.balls));
+        hits(&internals::sphere::closest::<K, L>(self.rays, self.balls));
     }
     fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) {
         let mut cache = [FocalSphere::new(self.eye, &self.balls[0]); 3];
@@ -182,17 +183,23 @@ impl<L: Lane<Scalar = f32>> Visitor for Closest<'_, L> {
                 FocalSphere::unguarded(self.eye, s)
             };
         }
-        hits(&sf::closest::<K, L>(self.rays, &cache));
+        hits(&internals::sphere::focal::closest::<K, L>(
+            self.rays, &cache,
+        ));
     }
     fn plane(self, _: Kernel) {
-        hits(&plane::closest::<L>(self.rays, self.walls));
+        hits(&internals::plane::closest::<L>(self.rays, self.walls));
     }
     fn focal_plane(self, _: Kernel) {
         let cache = [FocalPlane::new(self.eye, &self.walls[0])];
-        hits(&plane::closest_focal::<L>(self.rays, &cache));
+        hits(&internals::plane::closest_focal::<L>(self.rays, &cache));
     }
     fn triangle<K: TriangleKernel>(self, _: Kernel) {
-        hits(&triangle::closest::<K, L>(self.rays, self.tris, Cull::None));
+        hits(&internals::triangle::closest::<K, L>(
+            self.rays,
+            self.tris,
+            Cull::None,
+        ));
     }
     fn focal_triangle(self, _: Kernel) {
         let mut cache = [FocalTriangle::never(); 2];
@@ -224,24 +231,30 @@ pub fn every_kernel<L: Lane<Scalar = f32>>(rays: &RayPacket<L>, ray: &Ray) {
         });
     }
     // The other entry points: 1 ray × N primitives in lanes, any, all, one ray, meshes.
-    sink(sphere::any::<Robust, L>(rays, &balls).bits());
-    sphere::all::<Robust, L>(rays, &balls, |i, r| sink(i ^ r.any().bits()));
+    sink(internals::sphere::any::<Robust, L>(rays, &balls).bits());
+    internals::sphere::all::<Robust, L>(rays, &balls, |i, r| sink(i ^ r.any().bits()));
     let mut packed = [SpherePacket::<L>::from_spheres(&[]); 1];
     SpherePacket::pack(&balls, &mut packed);
-    rec(sphere::closest_soa::<Robust, L>(ray, &packed));
-    rec(sphere::intersect::<Robust>(ray, &balls[0]));
+    rec(internals::sphere::closest_soa::<Robust, L>(ray, &packed));
+    rec(internals::sphere::intersect::<Robust>(ray, &balls[0]));
     let mut cache = [FocalSphere::new(eye, &balls[0]); 3];
-    sf::focus(eye, &balls, &mut cache);
-    sink(sf::any::<Focal, L>(rays, &cache).bits());
+    internals::sphere::focal::focus(eye, &balls, &mut cache);
+    sink(internals::sphere::focal::any::<Focal, L>(rays, &cache).bits());
     let mut fpacked = [FocalSphere::<L>::gather(&[]); 1];
     FocalSphere::pack(&cache, &mut fpacked);
-    rec(sf::closest_soa::<Focal, L>(ray, &fpacked));
-    hits(&triangle::closest::<Moller, L>(rays, &tris, Cull::Back));
-    sink(triangle::any::<Watertight, L>(rays, &tris, Cull::None).bits());
-    triangle::all::<Moller, L>(rays, &tris, Cull::None, |i, h| sink(i ^ h.mask.bits()));
+    rec(internals::sphere::focal::closest_soa::<Focal, L>(
+        ray, &fpacked,
+    ));
+    hits(&internals::triangle::closest::<Moller, L>(
+        rays,
+        &tris,
+        Cull::Back,
+    ));
+    sink(internals::triangle::any::<Watertight, L>(rays, &tris, Cull::None).bits());
+    internals::triangle::all::<Moller, L>(rays, &tris, Cull::None, |i, h| sink(i ^ h.mask.bits()));
     let mut tpacked = [TrianglePacket::<L>::from_triangles(&[]); 1];
     TrianglePacket::pack(&tris, &mut tpacked);
-    rec(triangle::closest_soa::<Watertight, L>(
+    rec(internals::triangle::closest_soa::<Watertight, L>(
         ray,
         &tpacked,
         Cull::None,

@@ -2,13 +2,13 @@
 //! point. (Triangles have their own bad-input tests in tests/triangles.rs.)
 
 use glam::Vec3;
-use raylane::plane::{self, FocalPlane, Plane};
+use raylane::internals;
+use raylane::plane::{FocalPlane, Plane};
 use raylane::registry::{Kernel, Prim, Visitor};
+use raylane::sphere::focal::Focal;
 use raylane::sphere::focal::FocalKernel;
-use raylane::sphere::focal::{self, Focal};
 use raylane::sphere::{
-    self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere, SphereKernel,
-    SpherePacket,
+    FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere, SphereKernel, SpherePacket,
 };
 use raylane::triangle::TriangleKernel;
 use raylane::{Lane, Ray, RayPacket};
@@ -66,7 +66,7 @@ fn misses<K: SphereKernel>(ray: &Ray, s: &Sphere, what: &str) {
     );
     let p = K::roots(&RayPacket::<f32x8>::splat(ray), &SpherePacket::splat(s));
     assert!(p.any().none(), "{} {what}: a packet hit", K::NAME);
-    assert_eq!(sphere::intersect::<K>(ray, s), None);
+    assert_eq!(internals::sphere::intersect::<K>(ray, s), None);
 }
 
 fn focal_misses<K: FocalKernel>(ray: &Ray, s: &Sphere, guarded: bool, what: &str) {
@@ -119,7 +119,7 @@ fn every_kernel_misses(ray: &Ray, s: &Sphere, what: &str) {
 fn bad_rays_miss_every_sphere_kernel() {
     for (what, ray) in bad_rays() {
         every_kernel_misses(&ray, &ball(), what);
-        let p = plane::intersect(&ray, &Plane::new(Vec3::X, Vec3::X));
+        let p = internals::plane::intersect(&ray, &Plane::new(Vec3::X, Vec3::X));
         assert_eq!(p, None, "plane {what}");
     }
 }
@@ -134,10 +134,10 @@ fn bad_spheres_are_never_hit() {
     }
     // The same ray hits the good sphere with every kernel.
     for t in [
-        sphere::intersect::<Quadratic>(&ray, &ball()),
-        sphere::intersect::<QuadraticUnit>(&ray, &ball()),
-        sphere::intersect::<Geometric>(&ray, &ball()),
-        sphere::intersect::<Robust>(&ray, &ball()),
+        internals::sphere::intersect::<Quadratic>(&ray, &ball()),
+        internals::sphere::intersect::<QuadraticUnit>(&ray, &ball()),
+        internals::sphere::intersect::<Geometric>(&ray, &ball()),
+        internals::sphere::intersect::<Robust>(&ray, &ball()),
     ] {
         assert_eq!(t.map(|h| h.t), Some(2.0));
     }
@@ -158,7 +158,7 @@ fn bad_planes_miss() {
         ("behind", Plane::new(-Vec3::X, Vec3::X)),
     ];
     for (what, p) in cases {
-        assert_eq!(plane::intersect(&ray, &p), None, "{what}");
+        assert_eq!(internals::plane::intersect(&ray, &p), None, "{what}");
         let f = FocalPlane::new(ray.origin(), &p).intersect_lanes(&RayPacket::<f32>::splat(&ray));
         assert!(!f.mask && f.t == INF, "focal {what}");
     }
@@ -170,18 +170,20 @@ fn slices_of_bad_input_give_canonical_misses() {
     spheres.push(Sphere::new(Vec3::new(10.0, 0.0, 0.0), 1.0));
     let rays: Vec<Ray> = bad_rays().into_iter().map(|(_, r)| r).collect();
     let rp = RayPacket::<f32x8>::from_rays(&rays);
-    let h = sphere::closest::<Robust, f32x8>(&rp, &spheres);
+    let h = internals::sphere::closest::<Robust, f32x8>(&rp, &spheres);
     assert!(h.mask.none());
     for i in 0..8 {
         assert_eq!(h.t.lane(i), INF);
         assert_eq!(h.index[i], u32::MAX);
     }
-    assert!(sphere::any::<Robust, f32x8>(&rp, &spheres).none());
+    assert!(internals::sphere::any::<Robust, f32x8>(&rp, &spheres).none());
     let mut cache = vec![FocalSphere::new(Vec3::ZERO, &ball()); spheres.len()];
-    focal::focus(Vec3::new(NAN, 0.0, 0.0), &spheres, &mut cache);
+    internals::sphere::focal::focus(Vec3::new(NAN, 0.0, 0.0), &spheres, &mut cache);
     let good = RayPacket::<f32x8>::splat(&Ray::new(Vec3::ZERO, Vec3::X));
     assert!(
-        focal::closest::<Focal, f32x8>(&good, &cache).mask.none(),
+        internals::sphere::focal::closest::<Focal, f32x8>(&good, &cache)
+            .mask
+            .none(),
         "a NaN eye hits nothing"
     );
 }

@@ -24,10 +24,12 @@
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
+use raylane::internals;
+use raylane::internals::HitRecord;
 use raylane::mesh::Mesh;
-use raylane::triangle::{self, Triangle, focal};
+use raylane::triangle::Triangle;
 use raylane::triangle::{Cull, FocalTriangle, Moller, TriangleKernel, Watertight};
-use raylane::{HitRecord, Lane, Ray, RayPacket};
+use raylane::{Lane, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
 use crate::exact_ref::exact;
@@ -281,7 +283,7 @@ fn closest_among<K: TriangleKernel>(m: &Model, cand: &[u32], ray: &Ray) -> Optio
             Triangle::new(a, b, c)
         })
         .collect();
-    triangle::closest::<K, f32>(&RayPacket::splat(ray), &tris, Cull::None)
+    internals::triangle::closest::<K, f32>(&RayPacket::splat(ray), &tris, Cull::None)
         .get()
         .map(|h| HitRecord {
             index: cand[h.index as usize],
@@ -310,7 +312,7 @@ fn focal_soa<L: Lane<Scalar = f32>>(
     let mut packed = vec![FocalTriangle::<L>::gather(&[]); cache.len().div_ceil(L::LANES)];
     FocalTriangle::pack(cache, &mut packed);
     rays.iter()
-        .map(|r| focal::closest_soa(r, &packed, Cull::None))
+        .map(|r| internals::triangle::focal::closest_soa(r, &packed, Cull::None))
         .collect()
 }
 

@@ -16,7 +16,8 @@ use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::Ray;
-use raylane::triangle::{self, Cull, FocalTriangle, Moller, Triangle, Watertight, focal};
+use raylane::internals;
+use raylane::triangle::{Cull, FocalTriangle, Moller, Triangle, Watertight};
 
 use crate::exact_ref::{Exact, exact};
 
@@ -154,7 +155,7 @@ struct Stat {
 }
 
 impl Stat {
-    fn add(&mut self, x: &Exact, h: Option<raylane::HitRecord>) {
+    fn add(&mut self, x: &Exact, h: Option<raylane::internals::HitRecord>) {
         match h {
             Some(h) => {
                 self.t = self.t.max(x.t_err(h.t));
@@ -195,12 +196,19 @@ fn focal_is_as_accurate_as_moller() {
             kept += 1;
             let ray = Ray::new(eye, dir);
             let tri = Triangle::new(a, b, c);
-            let f = focal::intersect(&ray, &FocalTriangle::new(eye, &tri), Cull::None);
+            let f = internals::triangle::focal::intersect(
+                &ray,
+                &FocalTriangle::new(eye, &tri),
+                Cull::None,
+            );
             s[0].add(&x, f);
-            s[1].add(&x, triangle::intersect::<Moller>(&ray, &tri, Cull::None));
+            s[1].add(
+                &x,
+                internals::triangle::intersect::<Moller>(&ray, &tri, Cull::None),
+            );
             s[2].add(
                 &x,
-                triangle::intersect::<Watertight>(&ray, &tri, Cull::None),
+                internals::triangle::intersect::<Watertight>(&ray, &tri, Cull::None),
             );
             if x.margin / x.t < 2f64.powi(-18)
                 && let Some(h) = f

@@ -3,12 +3,14 @@
 //! records (issue 10: the interval bug, Required 5 and 6).
 
 use glam::Vec3;
+use raylane::internals;
+use raylane::internals::HitRecord;
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
 use raylane::triangle::{
-    self, Cramer, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, Watertight, focal,
+    Cramer, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, Watertight,
 };
-use raylane::{HitRecord, Query, Ray, RayPacket};
+use raylane::{Query, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
 /// Every focal entry point on one ray over `tris` from the ray's origin: the scalar record
@@ -16,7 +18,8 @@ use wide::{f32x4, f32x8, f32x16};
 fn focal_all_entry_points(ray: &Ray, tris: &[Triangle], cull: Cull) -> Option<HitRecord> {
     let eye = ray.origin();
     let cache: Vec<FocalTriangle<f32>> = tris.iter().map(|t| FocalTriangle::new(eye, t)).collect();
-    let want = focal::closest(&RayPacket::<f32>::splat(ray), &cache, cull).get();
+    let want =
+        internals::triangle::focal::closest(&RayPacket::<f32>::splat(ray), &cache, cull).get();
     let same = |h: Option<HitRecord>, what: &str| {
         let bits = |h: Option<HitRecord>| {
             h.map(|h| (h.t.to_bits(), h.u.to_bits(), h.v.to_bits(), h.index))
@@ -29,13 +32,13 @@ fn focal_all_entry_points(ray: &Ray, tris: &[Triangle], cull: Cull) -> Option<Hi
         cull: Cull,
     ) -> (Vec<Option<HitRecord>>, Option<HitRecord>, bool, bool) {
         let rp = RayPacket::<L>::splat(ray);
-        let h = focal::closest(&rp, cache, cull);
+        let h = internals::triangle::focal::closest(&rp, cache, cull);
         let lanes = (0..L::LANES).map(|i| h.lane(i)).collect();
         let mut packed = vec![FocalTriangle::<L>::gather(&[]); cache.len().div_ceil(L::LANES)];
         FocalTriangle::pack(cache, &mut packed);
-        let soa = focal::closest_soa(ray, &packed, cull);
-        let any = focal::any(&rp, cache, cull).all();
-        let any_soa = focal::any_soa(ray, &packed, cull);
+        let soa = internals::triangle::focal::closest_soa(ray, &packed, cull);
+        let any = internals::triangle::focal::any(&rp, cache, cull).all();
+        let any_soa = internals::triangle::focal::any_soa(ray, &packed, cull);
         (lanes, soa, any, any_soa)
     }
     let check = |(lanes, soa, any, any_soa): (Vec<Option<HitRecord>>, _, bool, bool), w: &str| {
@@ -53,7 +56,7 @@ fn focal_all_entry_points(ray: &Ray, tris: &[Triangle], cull: Cull) -> Option<Hi
     // One triangle at a time, and `all`.
     let mut first: Option<HitRecord> = None;
     for (i, e) in cache.iter().enumerate() {
-        if let Some(h) = focal::intersect(ray, e, cull)
+        if let Some(h) = internals::triangle::focal::intersect(ray, e, cull)
             && first.is_none_or(|f| h.t < f.t)
         {
             first = Some(HitRecord {
@@ -127,8 +130,8 @@ fn focal_hits_never_leave_their_interval() {
         None
     );
     for (ray, tri) in [(&tiny, wall(10.0)), (&huge, wall(1.0e-7))] {
-        assert!(triangle::intersect::<Moller>(ray, &tri, Cull::None).is_none());
-        assert!(triangle::intersect::<Watertight>(ray, &tri, Cull::None).is_none());
+        assert!(internals::triangle::intersect::<Moller>(ray, &tri, Cull::None).is_none());
+        assert!(internals::triangle::intersect::<Watertight>(ray, &tri, Cull::None).is_none());
     }
     // Representable t at the ends: a subnormal t (1e-6/3e38 = 3.3e-45 → 2 or 3·2^-149) and a
     // t just below f32::MAX are hits.
@@ -176,7 +179,7 @@ fn focal_fill_rule_on_lone_triangles_and_fans() {
     let tri = Triangle::new(a, b, c);
     fn others(ray: &Ray, t: &Triangle) -> [bool; 3] {
         fn one<K: TriangleKernel>(ray: &Ray, t: &Triangle) -> bool {
-            triangle::intersect::<K>(ray, t, Cull::None).is_some()
+            internals::triangle::intersect::<K>(ray, t, Cull::None).is_some()
         }
         [
             one::<Cramer>(ray, t),
@@ -224,7 +227,7 @@ fn focal_fill_rule_on_lone_triangles_and_fans() {
             let cache: Vec<_> = fan.iter().map(|t| FocalTriangle::new(eye, t)).collect();
             let n = cache
                 .iter()
-                .filter(|e| focal::intersect(&ray, e, Cull::None).is_some())
+                .filter(|e| internals::triangle::focal::intersect(&ray, e, Cull::None).is_some())
                 .count();
             assert_eq!(n, 1, "fan lift {lift}, eye {eye}");
             assert!(focal_all_entry_points(&ray, &fan, Cull::None).is_some());
@@ -256,13 +259,14 @@ fn records_carry_plus_zero() {
             }
         };
         let mut n = 0;
-        if let Some(h) = triangle::intersect::<K>(ray, tri, Cull::None) {
+        if let Some(h) = internals::triangle::intersect::<K>(ray, tri, Cull::None) {
             plus(h);
             n += 1;
         }
-        let h = triangle::closest::<K, f32x8>(&RayPacket::splat(ray), &[*tri], Cull::None);
+        let h =
+            internals::triangle::closest::<K, f32x8>(&RayPacket::splat(ray), &[*tri], Cull::None);
         (0..8).filter_map(|i| h.lane(i)).for_each(plus);
-        let h = triangle::closest::<K, f32>(&RayPacket::splat(ray), &[*tri], Cull::None);
+        let h = internals::triangle::closest::<K, f32>(&RayPacket::splat(ray), &[*tri], Cull::None);
         h.get().into_iter().for_each(plus);
         n
     }

@@ -26,17 +26,17 @@ use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
-use raylane::hit::{Best, HitRecord};
+use raylane::internals;
+use raylane::internals::{Best, HitRecord};
 use raylane::mesh::Mesh;
-use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
-use raylane::sphere::focal::{self as sf, Focal, FocalKernel, FocalUnguarded};
+use raylane::plane::{FocalPlane, Plane, PlanePacket};
+use raylane::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
 use raylane::sphere::{
     self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Roots, Sphere, SphereKernel,
     SpherePacket,
 };
-use raylane::triangle::focal as tf;
 use raylane::triangle::{
-    self, Cramer, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket, Watertight,
+    Cramer, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket, Watertight,
 };
 use raylane::{Hits, Lane, Mask, Pinhole, Query, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
@@ -365,7 +365,7 @@ fn sphere_kernel<K: SphereKernel, L: Lane<Scalar = f32>>(c: &Case) {
             let one = K::roots(&RayPacket::<f32>::splat(ray), &SpherePacket::splat(s));
             let want = roots_ok(name, ray, &one, 0);
             same(name, roots_ok(name, ray, &p, i), want);
-            let rec = sphere::intersect::<K>(ray, s);
+            let rec = internals::sphere::intersect::<K>(ray, s);
             if let Some(h) = rec {
                 record_ok(name, ray, &h, true);
                 // The surface of a hit: finite, unit normal.
@@ -381,12 +381,12 @@ fn sphere_kernel<K: SphereKernel, L: Lane<Scalar = f32>>(c: &Case) {
         }
     }
     // Slices: closest, any, all; both packet shapes.
-    let h = sphere::closest::<K, L>(&packet, &c.spheres);
-    let any = sphere::any::<K, L>(&packet, &c.spheres);
+    let h = internals::sphere::closest::<K, L>(&packet, &c.spheres);
+    let any = internals::sphere::any::<K, L>(&packet, &c.spheres);
     let mut packed = vec![SpherePacket::<L>::from_spheres(&[]); c.spheres.len()];
     let n = SpherePacket::pack(&c.spheres, &mut packed);
     for (i, ray) in rays.iter().enumerate() {
-        let one = sphere::closest::<K, f32>(&RayPacket::splat(ray), &c.spheres).get();
+        let one = internals::sphere::closest::<K, f32>(&RayPacket::splat(ray), &c.spheres).get();
         same(name, bits(h.lane(i)), bits(one));
         if let Some(r) = one {
             record_ok(name, ray, &r, true);
@@ -394,16 +394,16 @@ fn sphere_kernel<K: SphereKernel, L: Lane<Scalar = f32>>(c: &Case) {
         same(name, any.test(i), one.is_some());
         same(
             name,
-            bits(sphere::closest_soa::<K, L>(ray, &packed[..n])),
+            bits(internals::sphere::closest_soa::<K, L>(ray, &packed[..n])),
             bits(one),
         );
         same(
             name,
-            sphere::any_soa::<K, L>(ray, &packed[..n]),
+            internals::sphere::any_soa::<K, L>(ray, &packed[..n]),
             one.is_some(),
         );
     }
-    sphere::all::<K, L>(&packet, &c.spheres, |_, r| {
+    internals::sphere::all::<K, L>(&packet, &c.spheres, |_, r| {
         for (i, ray) in rays.iter().enumerate() {
             roots_ok(name, ray, r, i);
         }
@@ -416,7 +416,7 @@ fn focal_sphere<K: FocalKernel, L: Lane<Scalar = f32>>(c: &Case, guarded: bool) 
     let name = K::NAME;
     let mut cache = vec![FocalSphere::pass_all(); c.spheres.len()];
     if guarded {
-        sf::focus(c.eye, &c.spheres, &mut cache);
+        internals::sphere::focal::focus(c.eye, &c.spheres, &mut cache);
     } else {
         for (s, e) in c.spheres.iter().zip(&mut cache) {
             *e = FocalSphere::unguarded(c.eye, s);
@@ -424,7 +424,7 @@ fn focal_sphere<K: FocalKernel, L: Lane<Scalar = f32>>(c: &Case, guarded: bool) 
     }
     for e in &cache {
         let p = K::roots(&packet, &FocalSphere::<L>::splat(e));
-        let g = K::roots(&packet, &sf::Splat(e));
+        let g = K::roots(&packet, &internals::sphere::focal::Splat(e));
         for (i, ray) in rays.iter().enumerate() {
             let one = K::roots(&RayPacket::<f32>::splat(ray), &FocalSphere::<f32>::splat(e));
             let want = roots_ok(name, ray, &one, 0);
@@ -432,12 +432,12 @@ fn focal_sphere<K: FocalKernel, L: Lane<Scalar = f32>>(c: &Case, guarded: bool) 
             same(name, roots_ok(name, ray, &g, i), want);
         }
     }
-    let h = sf::closest::<K, L>(&packet, &cache);
-    let any = sf::any::<K, L>(&packet, &cache);
+    let h = internals::sphere::focal::closest::<K, L>(&packet, &cache);
+    let any = internals::sphere::focal::any::<K, L>(&packet, &cache);
     let mut packed = vec![FocalSphere::<L>::gather(&[]); cache.len()];
     let n = FocalSphere::pack(&cache, &mut packed);
     for (i, ray) in rays.iter().enumerate() {
-        let one = sf::closest::<K, f32>(&RayPacket::splat(ray), &cache).get();
+        let one = internals::sphere::focal::closest::<K, f32>(&RayPacket::splat(ray), &cache).get();
         same(name, bits(h.lane(i)), bits(one));
         if let Some(r) = one {
             record_ok(name, ray, &r, true);
@@ -445,12 +445,19 @@ fn focal_sphere<K: FocalKernel, L: Lane<Scalar = f32>>(c: &Case, guarded: bool) 
         same(name, any.test(i), one.is_some());
         same(
             name,
-            bits(sf::closest_soa::<K, L>(ray, &packed[..n])),
+            bits(internals::sphere::focal::closest_soa::<K, L>(
+                ray,
+                &packed[..n],
+            )),
             bits(one),
         );
-        same(name, sf::any_soa::<K, L>(ray, &packed[..n]), one.is_some());
+        same(
+            name,
+            internals::sphere::focal::any_soa::<K, L>(ray, &packed[..n]),
+            one.is_some(),
+        );
     }
-    sf::all::<K, L>(&packet, &cache, |_, r| {
+    internals::sphere::focal::all::<K, L>(&packet, &cache, |_, r| {
         for (i, ray) in rays.iter().enumerate() {
             roots_ok(name, ray, r, i);
         }
@@ -464,9 +471,9 @@ fn planes<L: Lane<Scalar = f32>>(c: &Case) {
     let rays = &c.rays[..L::LANES];
     let packet = RayPacket::<L>::from_rays(rays);
     for p in &c.planes {
-        let h = plane::intersect_lanes(&packet, &PlanePacket::splat(p));
+        let h = internals::plane::intersect_lanes(&packet, &PlanePacket::splat(p));
         for (i, ray) in rays.iter().enumerate() {
-            let one = plane::intersect(ray, p);
+            let one = internals::plane::intersect(ray, p);
             if let Some(r) = one {
                 record_ok("plane", ray, &r, true);
             }
@@ -476,22 +483,22 @@ fn planes<L: Lane<Scalar = f32>>(c: &Case) {
             }
         }
     }
-    let h = plane::closest::<L>(&packet, &c.planes);
-    let any = plane::any::<L>(&packet, &c.planes);
+    let h = internals::plane::closest::<L>(&packet, &c.planes);
+    let any = internals::plane::any::<L>(&packet, &c.planes);
     let soa = PlanePacket::<L>::from_planes(&c.planes[..c.planes.len().min(L::LANES)]);
     for (i, ray) in rays.iter().enumerate() {
-        let one = plane::closest::<f32>(&RayPacket::splat(ray), &c.planes).get();
+        let one = internals::plane::closest::<f32>(&RayPacket::splat(ray), &c.planes).get();
         same("plane closest", bits(h.lane(i)), bits(one));
         same("plane any", any.test(i), one.is_some());
         if c.planes.len() <= L::LANES {
             same(
                 "plane closest_soa",
-                bits(plane::closest_soa::<L>(ray, &[soa])),
+                bits(internals::plane::closest_soa::<L>(ray, &[soa])),
                 bits(one),
             );
         }
     }
-    plane::all::<L>(&packet, &c.planes, |_, h| {
+    internals::plane::all::<L>(&packet, &c.planes, |_, h| {
         for (i, ray) in rays.iter().enumerate() {
             if h.mask.test(i) {
                 assert!(h.t.lane(i) > ray.t_min() && h.t.lane(i) < ray.t_max());
@@ -502,9 +509,9 @@ fn planes<L: Lane<Scalar = f32>>(c: &Case) {
     let rays = &c.eye_rays[..L::LANES];
     let packet = RayPacket::<L>::from_rays(rays);
     let cache: Vec<FocalPlane> = c.planes.iter().map(|p| FocalPlane::new(c.eye, p)).collect();
-    let h = plane::closest_focal::<L>(&packet, &cache);
+    let h = internals::plane::closest_focal::<L>(&packet, &cache);
     for (i, ray) in rays.iter().enumerate() {
-        let one = plane::closest_focal::<f32>(&RayPacket::splat(ray), &cache).get();
+        let one = internals::plane::closest_focal::<f32>(&RayPacket::splat(ray), &cache).get();
         same("plane focal lanes", bits(h.lane(i)), bits(one));
         if let Some(r) = one {
             record_ok("plane focal", ray, &r, true);
@@ -513,7 +520,7 @@ fn planes<L: Lane<Scalar = f32>>(c: &Case) {
         same(
             "plane focal = plane",
             bits(one),
-            bits(plane::closest::<f32>(&RayPacket::splat(ray), &c.planes).get()),
+            bits(internals::plane::closest::<f32>(&RayPacket::splat(ray), &c.planes).get()),
         );
     }
 }
@@ -537,11 +544,13 @@ fn triangle_kernel<K: TriangleKernel, L: Lane<Scalar = f32>>(c: &Case, cull: Cul
     let rays = &c.rays[..L::LANES];
     let packet = RayPacket::<L>::from_rays(rays);
     let name = K::NAME;
-    let h = triangle::closest::<K, L>(&packet, &c.tris, cull);
-    let any = triangle::any::<K, L>(&packet, &c.tris, cull);
+    let h = internals::triangle::closest::<K, L>(&packet, &c.tris, cull);
+    let any = internals::triangle::any::<K, L>(&packet, &c.tris, cull);
     let mut packed = vec![TrianglePacket::<L>::from_triangles(&[]); c.tris.len()];
     let n = TrianglePacket::pack(&c.tris, &mut packed);
-    let one = |ray: &Ray| triangle::closest::<K, f32>(&RayPacket::splat(ray), &c.tris, cull).get();
+    let one = |ray: &Ray| {
+        internals::triangle::closest::<K, f32>(&RayPacket::splat(ray), &c.tris, cull).get()
+    };
     hits_agree(name, rays, &h, one);
     for (i, ray) in rays.iter().enumerate() {
         let o = one(ray);
@@ -551,21 +560,25 @@ fn triangle_kernel<K: TriangleKernel, L: Lane<Scalar = f32>>(c: &Case, cull: Cul
         same(name, any.test(i), o.is_some());
         same(
             name,
-            bits(triangle::closest_soa::<K, L>(ray, &packed[..n], cull)),
+            bits(internals::triangle::closest_soa::<K, L>(
+                ray,
+                &packed[..n],
+                cull,
+            )),
             bits(o),
         );
         same(
             name,
-            triangle::any_soa::<K, L>(ray, &packed[..n], cull),
+            internals::triangle::any_soa::<K, L>(ray, &packed[..n], cull),
             o.is_some(),
         );
         for t in &c.tris {
-            if let Some(r) = triangle::intersect::<K>(ray, t, cull) {
+            if let Some(r) = internals::triangle::intersect::<K>(ray, t, cull) {
                 record_ok(name, ray, &r, true);
             }
         }
     }
-    triangle::all::<K, L>(&packet, &c.tris, cull, |_, h| {
+    internals::triangle::all::<K, L>(&packet, &c.tris, cull, |_, h| {
         for (i, ray) in rays.iter().enumerate() {
             if h.mask.test(i) {
                 let r = HitRecord {
@@ -589,11 +602,13 @@ fn focal_triangles<L: Lane<Scalar = f32>>(c: &Case, cull: Cull) {
         .iter()
         .map(|t| FocalTriangle::new(c.eye, t))
         .collect();
-    let h = tf::closest::<L>(&packet, &cache, cull);
-    let any = tf::any::<L>(&packet, &cache, cull);
+    let h = internals::triangle::focal::closest::<L>(&packet, &cache, cull);
+    let any = internals::triangle::focal::any::<L>(&packet, &cache, cull);
     let mut packed = vec![FocalTriangle::<L>::gather(&[]); cache.len()];
     let n = FocalTriangle::pack(&cache, &mut packed);
-    let one = |ray: &Ray| tf::closest::<f32>(&RayPacket::splat(ray), &cache, cull).get();
+    let one = |ray: &Ray| {
+        internals::triangle::focal::closest::<f32>(&RayPacket::splat(ray), &cache, cull).get()
+    };
     hits_agree("triangle-focal", rays, &h, one);
     for (i, ray) in rays.iter().enumerate() {
         let o = one(ray);
@@ -603,21 +618,25 @@ fn focal_triangles<L: Lane<Scalar = f32>>(c: &Case, cull: Cull) {
         same("triangle-focal any", any.test(i), o.is_some());
         same(
             "triangle-focal closest_soa",
-            bits(tf::closest_soa::<L>(ray, &packed[..n], cull)),
+            bits(internals::triangle::focal::closest_soa::<L>(
+                ray,
+                &packed[..n],
+                cull,
+            )),
             bits(o),
         );
         same(
             "triangle-focal any_soa",
-            tf::any_soa::<L>(ray, &packed[..n], cull),
+            internals::triangle::focal::any_soa::<L>(ray, &packed[..n], cull),
             o.is_some(),
         );
         for e in &cache {
-            if let Some(r) = tf::intersect(ray, e, cull) {
+            if let Some(r) = internals::triangle::focal::intersect(ray, e, cull) {
                 record_ok("triangle-focal intersect", ray, &r, check);
             }
         }
     }
-    tf::all::<L>(&packet, &cache, cull, |_, h| {
+    internals::triangle::focal::all::<L>(&packet, &cache, cull, |_, h| {
         for (i, ray) in rays.iter().enumerate() {
             if h.mask.test(i) {
                 let r = HitRecord {
@@ -759,7 +778,7 @@ fn bounds_and_camera<L: Lane<Scalar = f32>>(c: &Case, rng: &mut SmallRng) {
         }
         let e = b.focal(c.eye);
         let fr = RayPacket::<L>::from_rays(&c.eye_units[..L::LANES]);
-        let _ = Focal::candidate(&fr, &sf::Splat(&e));
+        let _ = Focal::candidate(&fr, &internals::sphere::focal::Splat(&e));
     }
     // The camera: pixels outside the image never give a valid ray; lanes equal scalar.
     let g = |rng: &mut SmallRng| {
@@ -935,10 +954,16 @@ fn focal_triangle_interval_cases_from_the_issue() {
         let mut packed = [FocalTriangle::<f32x8>::gather(&[])];
         FocalTriangle::pack(&cache, &mut packed);
         let results = [
-            tf::intersect(&ray, &e, Cull::None),
-            tf::closest::<f32>(&RayPacket::splat(&ray), &cache, Cull::None).get(),
-            tf::closest::<f32x8>(&RayPacket::splat(&ray), &cache, Cull::None).lane(7),
-            tf::closest_soa::<f32x8>(&ray, &packed, Cull::None),
+            internals::triangle::focal::intersect(&ray, &e, Cull::None),
+            internals::triangle::focal::closest::<f32>(&RayPacket::splat(&ray), &cache, Cull::None)
+                .get(),
+            internals::triangle::focal::closest::<f32x8>(
+                &RayPacket::splat(&ray),
+                &cache,
+                Cull::None,
+            )
+            .lane(7),
+            internals::triangle::focal::closest_soa::<f32x8>(&ray, &packed, Cull::None),
         ];
         for h in results.into_iter().flatten() {
             record_ok(
@@ -949,9 +974,12 @@ fn focal_triangle_interval_cases_from_the_issue() {
             );
         }
         // Möller and Watertight: no hit for either.
-        assert_eq!(triangle::intersect::<Moller>(&ray, &tri, Cull::None), None);
         assert_eq!(
-            triangle::intersect::<Watertight>(&ray, &tri, Cull::None),
+            internals::triangle::intersect::<Moller>(&ray, &tri, Cull::None),
+            None
+        );
+        assert_eq!(
+            internals::triangle::intersect::<Watertight>(&ray, &tri, Cull::None),
             None
         );
     }

@@ -4,12 +4,13 @@
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
-use raylane::hit::Best;
+use raylane::internals;
+use raylane::internals::Best;
 use raylane::lane::{Lane, Mask};
-use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
+use raylane::plane::{FocalPlane, Plane, PlanePacket};
 use raylane::registry::{Kernel, Prim, Visitor};
-use raylane::sphere::focal::{self, Focal, FocalKernel};
-use raylane::sphere::{self, FocalSphere, Robust, Roots, Sphere, SphereKernel, SpherePacket};
+use raylane::sphere::focal::{Focal, FocalKernel};
+use raylane::sphere::{FocalSphere, Robust, Roots, Sphere, SphereKernel, SpherePacket};
 use raylane::triangle::TriangleKernel;
 use raylane::{Ray, RayPacket, V3};
 use std::marker::PhantomData;
@@ -120,16 +121,17 @@ fn focal_kernel<K: FocalKernel, L: Lane<Scalar = f32>>(
 fn planes<L: Lane<Scalar = f32>>(rays: &[Ray], ps: &[Plane]) {
     let rp = RayPacket::<L>::from_rays(rays);
     let pp = PlanePacket::<L>::from_planes(ps);
-    let packed = plane::intersect_lanes(&rp, &pp);
+    let packed = internals::plane::intersect_lanes(&rp, &pp);
     let nums =
         L::from_f32_fn(|i| FocalPlane::new(rp.ray(i).origin(), &ps[i.min(ps.len() - 1)]).num());
-    let focal = plane::focal_lanes(&rp, nums, V3::from_fn(|i| ps[i.min(ps.len() - 1)].normal));
+    let focal =
+        internals::plane::focal_lanes(&rp, nums, V3::from_fn(|i| ps[i.min(ps.len() - 1)].normal));
     for i in 0..L::LANES {
         let p = ps
             .get(i)
             .copied()
             .unwrap_or(Plane::new(Vec3::ZERO, Vec3::ZERO));
-        let s = plane::intersect_lanes(
+        let s = internals::plane::intersect_lanes(
             &RayPacket::<f32>::splat(&rp.ray(i)),
             &PlanePacket::splat(&p),
         );
@@ -264,21 +266,27 @@ fn entry_points<L: Lane<Scalar = f32>>(seed: u64) {
             .map(|i| ray(&mut rng, spheres[i].center()))
             .collect();
         let rp = RayPacket::<L>::from_rays(&rays);
-        let closest = sphere::closest::<Robust, L>(&rp, &spheres);
-        let any = sphere::any::<Robust, L>(&rp, &spheres);
+        let closest = internals::sphere::closest::<Robust, L>(&rp, &spheres);
+        let any = internals::sphere::any::<Robust, L>(&rp, &spheres);
         let mut soa = vec![SpherePacket::<L>::from_spheres(&[]); spheres.len().div_ceil(L::LANES)];
         SpherePacket::pack(&spheres, &mut soa);
         for (i, r) in rays.iter().enumerate() {
-            let single = sphere::closest::<Robust, f32>(&RayPacket::splat(r), &spheres);
+            let single = internals::sphere::closest::<Robust, f32>(&RayPacket::splat(r), &spheres);
             same_hit(&closest, i, &single);
             assert_eq!(any.test(i), single.mask);
             // 1 ray × N spheres in lanes gives the same hit.
-            assert_eq!(sphere::closest_soa::<Robust, L>(r, &soa), single.get());
-            assert_eq!(sphere::any_soa::<Robust, L>(r, &soa), single.mask);
+            assert_eq!(
+                internals::sphere::closest_soa::<Robust, L>(r, &soa),
+                single.get()
+            );
+            assert_eq!(
+                internals::sphere::any_soa::<Robust, L>(r, &soa),
+                single.mask
+            );
         }
         // All hits: every root of every sphere, the same per lane as the scalar path.
         let mut seen = Vec::new();
-        sphere::all::<Robust, L>(&rp, &spheres, |i, roots| {
+        internals::sphere::all::<Robust, L>(&rp, &spheres, |i, roots| {
             for lane in 0..L::LANES {
                 let (t, n) = roots.lane(lane);
                 for t in &t[..n] {
@@ -288,7 +296,7 @@ fn entry_points<L: Lane<Scalar = f32>>(seed: u64) {
         });
         let mut want = Vec::new();
         for (lane, r) in rays.iter().enumerate() {
-            sphere::all::<Robust, f32>(&RayPacket::splat(r), &spheres, |i, roots| {
+            internals::sphere::all::<Robust, f32>(&RayPacket::splat(r), &spheres, |i, roots| {
                 let (t, n) = roots.lane(0);
                 for t in &t[..n] {
                     want.push((lane, i, t.to_bits()));
@@ -304,7 +312,7 @@ fn entry_points<L: Lane<Scalar = f32>>(seed: u64) {
             continue;
         }
         let mut cache = vec![FocalSphere::new(eye, &spheres[0]); spheres.len()];
-        focal::focus(eye, &spheres, &mut cache);
+        internals::sphere::focal::focus(eye, &spheres, &mut cache);
         let mut packed = vec![FocalSphere::<L>::gather(&[]); spheres.len().div_ceil(L::LANES)];
         FocalSphere::pack(&cache, &mut packed);
         let frays: Vec<Ray> = rays
@@ -312,14 +320,21 @@ fn entry_points<L: Lane<Scalar = f32>>(seed: u64) {
             .map(|r| Ray::new(eye, r.dir().normalize_or_zero()))
             .collect();
         let fp = RayPacket::<L>::from_rays(&frays);
-        let fc = focal::closest::<Focal, L>(&fp, &cache);
-        let fa = focal::any::<Focal, L>(&fp, &cache);
+        let fc = internals::sphere::focal::closest::<Focal, L>(&fp, &cache);
+        let fa = internals::sphere::focal::any::<Focal, L>(&fp, &cache);
         for (i, r) in frays.iter().enumerate() {
-            let single = focal::closest::<Focal, f32>(&RayPacket::splat(r), &cache);
+            let single =
+                internals::sphere::focal::closest::<Focal, f32>(&RayPacket::splat(r), &cache);
             same_hit(&fc, i, &single);
             assert_eq!(fa.test(i), single.mask);
-            assert_eq!(focal::closest_soa::<Focal, L>(r, &packed), single.get());
-            assert_eq!(focal::any_soa::<Focal, L>(r, &packed), single.mask);
+            assert_eq!(
+                internals::sphere::focal::closest_soa::<Focal, L>(r, &packed),
+                single.get()
+            );
+            assert_eq!(
+                internals::sphere::focal::any_soa::<Focal, L>(r, &packed),
+                single.mask
+            );
         }
     }
 }

@@ -9,10 +9,11 @@
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
+use raylane::internals;
 use raylane::lane::{Lane, Mask};
 use raylane::plane::Plane;
-use raylane::sphere::{self, Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
-use raylane::triangle::{self, Cull, Moller, Triangle, Watertight};
+use raylane::sphere::{Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
+use raylane::triangle::{Cull, Moller, Triangle, Watertight};
 use raylane::{Hit, Hits, Query, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
@@ -49,8 +50,8 @@ fn ray(rng: &mut SmallRng, c: Vec3, scale: f32) -> Ray {
 
 /// A query's record as the kernels' record (`t`, `u`, `v`, index), for the tests that compare
 /// with the kernels' own entry points.
-pub fn record(h: Option<Hit>) -> Option<raylane::HitRecord> {
-    h.map(|h| raylane::HitRecord {
+pub fn record(h: Option<Hit>) -> Option<raylane::internals::HitRecord> {
+    h.map(|h| raylane::internals::HitRecord {
         t: h.t,
         u: h.u,
         v: h.v,
@@ -179,7 +180,7 @@ fn sphere_queries_every_lane_equals_one_ray() {
         let hits = every_width(&s[..], &rays, "spheres");
         // The same t and index as the existing loop.
         for (r, h) in rays.iter().zip(&hits) {
-            let old = sphere::closest::<Robust, f32>(&RayPacket::splat(r), &s).get();
+            let old = internals::sphere::closest::<Robust, f32>(&RayPacket::splat(r), &s).get();
             assert_eq!(
                 old.map(|o| (o.t.to_bits(), o.index)),
                 h.map(|h| (h.t.to_bits(), h.index))
@@ -221,8 +222,12 @@ fn triangle_queries_every_lane_equals_one_ray() {
     rays.extend((0..40).map(|_| Ray::new(c, vec(&mut rng, 1.0))));
     let hits = every_width(&tris[..], &rays, "watertight");
     for (r, h) in rays.iter().zip(&hits) {
-        let old =
-            triangle::closest::<Watertight, f32>(&RayPacket::splat(r), &tris, Cull::None).get();
+        let old = internals::triangle::closest::<Watertight, f32>(
+            &RayPacket::splat(r),
+            &tris,
+            Cull::None,
+        )
+        .get();
         let key = |t: f32, u: f32, v: f32, i: u32| (t.to_bits(), u.to_bits(), v.to_bits(), i);
         assert_eq!(
             old.map(|o| key(o.t, o.u, o.v, o.index)),

@@ -6,8 +6,9 @@ use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
+use raylane::internals;
 use raylane::mesh::Mesh;
-use raylane::sphere::focal::{self as sf, Focal, FocalKernel};
+use raylane::sphere::focal::{Focal, FocalKernel};
 use raylane::sphere::{
     self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Roots, Sphere, SphereKernel,
     SpherePacket,
@@ -106,7 +107,10 @@ fn invalid_bound_culls_nothing_in_mesh_and_focal_mesh() {
     // The focal form of an invalid bound passes every ray, and is itself never hit.
     let e = Bound::new(&Sphere::new(Vec3::ZERO, -1.0)).focal(Vec3::ZERO);
     let rp = RayPacket::<f32>::splat(&ray);
-    assert!(<Focal as FocalKernel>::candidate(&rp, &sf::Splat(&e)));
+    assert!(<Focal as FocalKernel>::candidate(
+        &rp,
+        &internals::sphere::focal::Splat(&e)
+    ));
     assert!(!<Focal as FocalKernel>::roots(&rp, &FocalSphere::splat(&e)).any());
 }
 
@@ -206,7 +210,7 @@ fn tiny_sphere_roots_and_normal() {
             "{name}: {got:?}"
         );
     }
-    let hit = sphere::intersect::<Robust>(&ray, &s).unwrap();
+    let hit = internals::sphere::intersect::<Robust>(&ray, &s).unwrap();
     let sf = sphere::surface(
         &RayPacket::<f32>::splat(&ray),
         &SpherePacket::splat(&s),
@@ -217,7 +221,7 @@ fn tiny_sphere_roots_and_normal() {
     for r in [1e-25f32, 1e-38, 1e-44] {
         let s = Sphere::new(Vec3::ZERO, r);
         let ray = Ray::new(Vec3::new(0.0, -2.0 * r, 0.0), Vec3::Y);
-        let t = sphere::intersect::<Robust>(&ray, &s).map(|h| h.t);
+        let t = internals::sphere::intersect::<Robust>(&ray, &s).map(|h| h.t);
         let Some(t) = t else {
             panic!("r = {r}: no hit")
         };
@@ -282,10 +286,10 @@ fn near_tangent_far_roots_are_ascending_and_shapes_agree() {
 }
 
 fn same_shapes<K: SphereKernel>(ray: &Ray, spheres: &[Sphere]) {
-    let n = sphere::closest::<K, f32>(&RayPacket::splat(ray), spheres).get();
+    let n = internals::sphere::closest::<K, f32>(&RayPacket::splat(ray), spheres).get();
     let mut packed = [SpherePacket::<f32x8>::from_spheres(&[]); 2];
     let m = SpherePacket::pack(spheres, &mut packed);
-    let soa = sphere::closest_soa::<K, f32x8>(ray, &packed[..m]);
+    let soa = internals::sphere::closest_soa::<K, f32x8>(ray, &packed[..m]);
     assert_eq!(n, soa, "{}", K::NAME);
 }
 

@@ -10,19 +10,20 @@ use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
 use raylane::demo::shapes;
-use raylane::hit::Best;
+use raylane::internals;
+use raylane::internals::Best;
+use raylane::internals::{FocalRays, HitRecord, LaneHit};
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
 use raylane::opcount::{OpCounts, table};
 use raylane::registry::{Kernel, Prim, Visitor};
 use raylane::sphere::SphereKernel;
 use raylane::sphere::focal::FocalKernel;
-use raylane::triangle::focal as tf;
 use raylane::triangle::{
-    self, Badouel, BaldwinWeber, Cramer, Cull, FocalRays, FocalTriangle, HavelHerout, Moller,
-    Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
+    self, Badouel, BaldwinWeber, Cramer, Cull, FocalTriangle, HavelHerout, Moller, Plucker,
+    PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
 };
-use raylane::{HitRecord, Hits, LaneHit, Query, Ray, RayPacket};
+use raylane::{Hits, Query, Ray, RayPacket};
 use std::marker::PhantomData;
 use wide::{f32x4, f32x8, f32x16};
 
@@ -114,10 +115,15 @@ fn focal_kernel<L: Lane<Scalar = f32>>(rays: &[Ray], tris: &[Triangle]) {
         .collect();
     let cache = FocalTriangle::<L>::gather(&entries);
     for cull in CULLS {
-        let packed = tf::intersect_lanes(&FocalRays::new(&rp), &cache, cull);
+        let packed =
+            internals::triangle::focal::intersect_lanes(&FocalRays::new(&rp), &cache, cull);
         for (i, e) in entries.iter().enumerate() {
             let r = RayPacket::<f32>::splat(&rp.ray(i));
-            let s = tf::intersect_lanes(&FocalRays::new(&r), &FocalTriangle::splat(e), cull);
+            let s = internals::triangle::focal::intersect_lanes(
+                &FocalRays::new(&r),
+                &FocalTriangle::splat(e),
+                cull,
+            );
             same(&packed, i, &s, "focal");
         }
     }
@@ -173,10 +179,14 @@ fn intersect(k: Kernel, ray: &Ray, tri: &Triangle, cull: Cull) -> Option<HitReco
     impl Visitor for One<'_> {
         type Output = Option<HitRecord>;
         fn triangle<K: TriangleKernel>(self, _: Kernel) -> Self::Output {
-            triangle::intersect::<K>(self.0, self.1, self.2)
+            internals::triangle::intersect::<K>(self.0, self.1, self.2)
         }
         fn focal_triangle(self, _: Kernel) -> Self::Output {
-            tf::intersect(self.0, &FocalTriangle::new(self.0.origin(), self.1), self.2)
+            internals::triangle::focal::intersect(
+                self.0,
+                &FocalTriangle::new(self.0.origin(), self.1),
+                self.2,
+            )
         }
         fn sphere<K: SphereKernel>(self, k: Kernel) -> Self::Output {
             unreachable!("{} is not a triangle kernel", k.name())
@@ -267,7 +277,11 @@ fn fallback_lanes<L: Lane<Scalar = f32>>(seed: u64) {
             let tp = TrianglePacket::<L>::splat(&t);
             for cull in CULLS {
                 let packed = Watertight::intersect(&rp, &Watertight::prepare(&rp), &tp, cull);
-                let fpacked = tf::intersect_lanes(&fr, &FocalTriangle::splat(&fm.cache()[i]), cull);
+                let fpacked = internals::triangle::focal::intersect_lanes(
+                    &fr,
+                    &FocalTriangle::splat(&fm.cache()[i]),
+                    cull,
+                );
                 for (k, r) in rays.iter().enumerate() {
                     let s = RayPacket::<f32>::splat(r);
                     let single = Watertight::intersect(
@@ -277,7 +291,7 @@ fn fallback_lanes<L: Lane<Scalar = f32>>(seed: u64) {
                         cull,
                     );
                     same(&packed, k, &single, "watertight fallback");
-                    let fs = tf::intersect_lanes(
+                    let fs = internals::triangle::focal::intersect_lanes(
                         &FocalRays::new(&s),
                         &FocalTriangle::splat(&fm.cache()[i]),
                         cull,
@@ -330,8 +344,8 @@ fn entry_points_of<K: TriangleKernel, L: Lane<Scalar = f32>>(
     cull: Cull,
 ) {
     let rp = RayPacket::<L>::from_rays(rays);
-    let closest = triangle::closest::<K, L>(&rp, tris, cull);
-    let any = triangle::any::<K, L>(&rp, tris, cull);
+    let closest = internals::triangle::closest::<K, L>(&rp, tris, cull);
+    let any = internals::triangle::any::<K, L>(&rp, tris, cull);
     let mut soa = vec![TrianglePacket::<L>::from_triangles(&[]); tris.len().div_ceil(L::LANES)];
     TrianglePacket::pack(tris, &mut soa);
     let mq = mesh.using::<K>().culled(cull);
@@ -339,13 +353,22 @@ fn entry_points_of<K: TriangleKernel, L: Lane<Scalar = f32>>(
     let m_any = mq.any(&rp);
     for (i, r) in rays.iter().enumerate() {
         let s = RayPacket::<f32>::splat(r);
-        let single = triangle::closest::<K, f32>(&s, tris, cull);
+        let single = internals::triangle::closest::<K, f32>(&s, tris, cull);
         same_hit(&closest, i, &single, K::NAME);
         assert_eq!(any.test(i), single.mask, "{} any", K::NAME);
-        assert_eq!(triangle::closest_soa::<K, L>(r, &soa, cull), single.get());
-        assert_eq!(triangle::any_soa::<K, L>(r, &soa, cull), single.mask);
+        assert_eq!(
+            internals::triangle::closest_soa::<K, L>(r, &soa, cull),
+            single.get()
+        );
+        assert_eq!(
+            internals::triangle::any_soa::<K, L>(r, &soa, cull),
+            single.mask
+        );
         if tris.len() == 1 {
-            assert_eq!(triangle::intersect::<K>(r, &tris[0], cull), single.get());
+            assert_eq!(
+                internals::triangle::intersect::<K>(r, &tris[0], cull),
+                single.get()
+            );
         }
         let m_single = mq.closest(r);
         assert_eq!(m_closest.lane(i), m_single, "mesh closest, lane {i}");
@@ -361,7 +384,7 @@ fn entry_points_of<K: TriangleKernel, L: Lane<Scalar = f32>>(
         if use_mesh {
             mq.all(&rp, |h: Hits<L>| collect_hits(&mut seen, &h));
         } else {
-            triangle::all::<K, L>(&rp, tris, cull, |i, h| collect(&mut seen, i, h));
+            internals::triangle::all::<K, L>(&rp, tris, cull, |i, h| collect(&mut seen, i, h));
         }
         for (lane, r) in rays.iter().enumerate() {
             let s = RayPacket::<f32>::splat(r);
@@ -371,7 +394,7 @@ fn entry_points_of<K: TriangleKernel, L: Lane<Scalar = f32>>(
                     add(h.index, &LaneHit::new(h.t, h.u, h.v, true))
                 });
             } else {
-                triangle::all::<K, f32>(&s, tris, cull, &mut add);
+                internals::triangle::all::<K, f32>(&s, tris, cull, &mut add);
             }
         }
         seen.sort_unstable();
@@ -393,7 +416,7 @@ where
         tris.len()
     );
     let stored = triangle::closest_precomputed::<K, L>(&rp, &records, cull);
-    let fresh = triangle::closest::<K, L>(&rp, tris, cull);
+    let fresh = internals::triangle::closest::<K, L>(&rp, tris, cull);
     for i in 0..rays.len() {
         assert_eq!(
             stored.lane(i),
@@ -413,27 +436,27 @@ fn focal_entry_points<L: Lane<Scalar = f32>>(
 ) {
     let rp = RayPacket::<L>::from_rays(rays);
     let mut cache = vec![FocalTriangle::never(); tris.len()];
-    tf::focus(eye, tris, &mut cache);
+    internals::triangle::focal::focus(eye, tris, &mut cache);
     let mut packed = vec![FocalTriangle::<L>::gather(&[]); tris.len().div_ceil(L::LANES)];
     FocalTriangle::pack(&cache, &mut packed);
-    let closest = tf::closest::<L>(&rp, &cache, cull);
-    let any = tf::any::<L>(&rp, &cache, cull);
+    let closest = internals::triangle::focal::closest::<L>(&rp, &cache, cull);
+    let any = internals::triangle::focal::any::<L>(&rp, &cache, cull);
     let mut mcache = vec![FocalTriangle::never(); mesh.len()];
     let fm = mesh.focus(eye, &mut mcache).unwrap().culled(cull);
     let m_closest = fm.closest(&rp);
     let m_any = fm.any(&rp);
     for (i, r) in rays.iter().enumerate() {
         let s = RayPacket::<f32>::splat(r);
-        let single = tf::closest::<f32>(&s, &cache, cull);
+        let single = internals::triangle::focal::closest::<f32>(&s, &cache, cull);
         same_hit(&closest, i, &single, "focal closest");
         assert_eq!(any.test(i), single.mask, "focal any");
         assert_eq!(
-            tf::closest_soa::<L>(r, &packed, cull),
+            internals::triangle::focal::closest_soa::<L>(r, &packed, cull),
             single.get(),
             "focal soa"
         );
         assert_eq!(
-            tf::any_soa::<L>(r, &packed, cull),
+            internals::triangle::focal::any_soa::<L>(r, &packed, cull),
             single.mask,
             "focal any soa"
         );
@@ -644,7 +667,8 @@ fn focal_doubtful_rays_hit() {
     // The edge value of AB is exactly zero; its normal (0, −20, 4) has first nonzero
     // component y < 0, and the other two edges are negative: a front face, claimed.
     let r = Ray::new(eye, Vec3::new(2.0, 0.0, 0.0) - eye);
-    let h = tf::intersect(&r, &e, Cull::None).expect("claimed by simulation of simplicity");
+    let h = internals::triangle::focal::intersect(&r, &e, Cull::None)
+        .expect("claimed by simulation of simplicity");
     assert_eq!((h.t, h.u, h.v), (1.0, 0.5, 0.0));
 }
 

@@ -15,12 +15,12 @@
 
 use core::hint::black_box;
 
-use raylane::hit::Best;
-use raylane::plane::{self, FocalPlane, Plane};
-use raylane::sphere::focal::{self as sf, Focal, FocalUnguarded};
-use raylane::sphere::{self, FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
-use raylane::triangle::focal as tf;
-use raylane::triangle::{self, Cramer, Cull, FocalTriangle, Moller, Triangle, Watertight};
+use raylane::internals;
+use raylane::internals::Best;
+use raylane::plane::{FocalPlane, Plane};
+use raylane::sphere::focal::{Focal, FocalUnguarded};
+use raylane::sphere::{FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
+use raylane::triangle::{Cramer, Cull, FocalTriangle, Moller, Triangle, Watertight};
 use raylane::{Mask, Ray, RayPacket};
 use raylane_fw::semihosting::hprintln;
 use raylane_fw::{entry, exit};
@@ -96,18 +96,18 @@ fn measure(s: &Scene, rays: &[Ray], name: &str) {
         };
     }
     let none = Cull::None;
-    kernel!("quadratic", r, u => sphere::closest::<Quadratic, _>(r, &s.spheres[..u]));
-    kernel!("quadratic-unit", r, u => sphere::closest::<QuadraticUnit, _>(r, &s.spheres[..u]));
-    kernel!("geometric", r, u => sphere::closest::<Geometric, _>(r, &s.spheres[..u]));
-    kernel!("robust", r, u => sphere::closest::<Robust, _>(r, &s.spheres[..u]));
-    kernel!("focal", r, u => sf::closest::<Focal, _>(r, &s.focal[..u]));
-    kernel!("focal-unguarded", r, u => sf::closest::<FocalUnguarded, _>(r, &s.unguarded[..u]));
-    kernel!("plane", r, u => plane::closest(r, &s.planes[..u]));
-    kernel!("plane-focal", r, u => plane::closest_focal(r, &s.focal_planes[..u]));
-    kernel!("cramer", r, u => triangle::closest::<Cramer, _>(r, &s.tris[..u], none));
-    kernel!("moller", r, u => triangle::closest::<Moller, _>(r, &s.tris[..u], none));
-    kernel!("watertight", r, u => triangle::closest::<Watertight, _>(r, &s.tris[..u], none));
-    kernel!("triangle-focal", r, u => tf::closest(r, &s.focal_tris[..u], none));
+    kernel!("quadratic", r, u => internals::sphere::closest::<Quadratic, _>(r, &s.spheres[..u]));
+    kernel!("quadratic-unit", r, u => internals::sphere::closest::<QuadraticUnit, _>(r, &s.spheres[..u]));
+    kernel!("geometric", r, u => internals::sphere::closest::<Geometric, _>(r, &s.spheres[..u]));
+    kernel!("robust", r, u => internals::sphere::closest::<Robust, _>(r, &s.spheres[..u]));
+    kernel!("focal", r, u => internals::sphere::focal::closest::<Focal, _>(r, &s.focal[..u]));
+    kernel!("focal-unguarded", r, u => internals::sphere::focal::closest::<FocalUnguarded, _>(r, &s.unguarded[..u]));
+    kernel!("plane", r, u => internals::plane::closest(r, &s.planes[..u]));
+    kernel!("plane-focal", r, u => internals::plane::closest_focal(r, &s.focal_planes[..u]));
+    kernel!("cramer", r, u => internals::triangle::closest::<Cramer, _>(r, &s.tris[..u], none));
+    kernel!("moller", r, u => internals::triangle::closest::<Moller, _>(r, &s.tris[..u], none));
+    kernel!("watertight", r, u => internals::triangle::closest::<Watertight, _>(r, &s.tris[..u], none));
+    kernel!("triangle-focal", r, u => internals::triangle::focal::closest(r, &s.focal_tris[..u], none));
 }
 
 fn digest(rays: &[Ray], s: &Scene) -> u64 {
