@@ -8,6 +8,7 @@
 //! and bad input (NaN/inf and coincident vertices, empty and one-triangle meshes, a thousand
 //! copies of one triangle, all primitives at one point, coordinates near `1e30`).
 
+use crate::query::bits;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
@@ -31,26 +32,6 @@ fn owned<P: Primitives + ?Sized>(p: &P) -> (Vec<Node>, Vec<P::Leaf>) {
     nodes.truncate(n);
     leaves.truncate(l);
     (nodes, leaves)
-}
-
-/// The record's bits (so `-0`/`+0` would show).
-fn bits(h: Option<Hit>) -> Option<[u32; 12]> {
-    h.map(|h| {
-        [
-            h.t.to_bits(),
-            h.point.x.to_bits(),
-            h.point.y.to_bits(),
-            h.point.z.to_bits(),
-            h.normal.x.to_bits(),
-            h.normal.y.to_bits(),
-            h.normal.z.to_bits(),
-            h.front as u32,
-            h.index,
-            h.set,
-            h.u.to_bits(),
-            h.v.to_bits(),
-        ]
-    })
 }
 
 fn v3(rng: &mut SmallRng, s: f32) -> Vec3 {

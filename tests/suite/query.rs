@@ -59,7 +59,8 @@ pub fn record(h: Option<Hit>) -> Option<raylane::internals::HitRecord> {
     })
 }
 
-fn bits(h: Option<Hit>) -> Option<[u32; 12]> {
+/// The record's bits (so `-0`/`+0` would show); shared with the BVH tests.
+pub(crate) fn bits(h: Option<Hit>) -> Option<[u32; 12]> {
     h.map(|h| {
         [
             h.t.to_bits(),
