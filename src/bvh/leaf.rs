@@ -68,6 +68,61 @@ pub trait Leaf: Packed {
         pre: &Self::Rays<f32x4>,
         cull: Cull,
     ) -> LaneHit<f32x4>;
+    /// What the per-eye cache of a [`FocalBvh`](super::FocalBvh) keeps of a leaf
+    /// ([`RelTri4`]: the vertices minus the eye; `()` for spheres, whose kernel's fallback
+    /// needs the centre itself).
+    type Rel: Copy + core::fmt::Debug;
+    /// The cache entry of a leaf not yet reached.
+    const REL_EMPTY: Self::Rel;
+    /// The cache entry for rays from `eye`.
+    fn relative(&self, eye: Vec3) -> Self::Rel;
+    /// [`test_four`](Self::test_four) for rays from the eye `rel` was made for: the same bits.
+    fn test_four_rel(
+        &self,
+        rel: &Self::Rel,
+        ray: &RayPacket<f32x4>,
+        pre: &Self::Rays<f32x4>,
+        cull: Cull,
+    ) -> LaneHit<f32x4>;
+    /// [`test_one`](Self::test_one) for rays from the eye `rel` was made for: the same bits.
+    fn test_one_rel<L: Lane>(
+        &self,
+        rel: &Self::Rel,
+        k: usize,
+        rays: &RayPacket<L>,
+        pre: &Self::Rays<L>,
+        cull: Cull,
+    ) -> LaneHit<L>;
+}
+
+/// Four triangles' vertices minus an eye (`A − E`, `B − E`, `C − E`, each coordinate rounded
+/// once, as the [`Watertight`] kernel's first step computes them for rays from `E`): what a
+/// [`FocalBvh`](super::FocalBvh) caches per leaf. 144 bytes.
+#[repr(C, align(16))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RelTri4 {
+    /// `A − E`: x, y, z lanes.
+    pub a: [[f32; LEAF_WIDTH]; 3],
+    /// `B − E`.
+    pub b: [[f32; LEAF_WIDTH]; 3],
+    /// `C − E`.
+    pub c: [[f32; LEAF_WIDTH]; 3],
+}
+
+impl RelTri4 {
+    /// No triangles (NaN: never hit).
+    pub const EMPTY: Self = RelTri4 {
+        a: [[f32::NAN; LEAF_WIDTH]; 3],
+        b: [[f32::NAN; LEAF_WIDTH]; 3],
+        c: [[f32::NAN; LEAF_WIDTH]; 3],
+    };
+}
+
+/// `v − eye`, lane by lane.
+#[inline(always)]
+fn minus(v: &[[f32; LEAF_WIDTH]; 3], eye: Vec3) -> [[f32; LEAF_WIDTH]; 3] {
+    let e = eye.to_array();
+    core::array::from_fn(|a| v[a].map(|x| x - e[a]))
 }
 
 /// A set of primitives a tree can be built over.
@@ -236,6 +291,51 @@ impl Leaf for Tri4 {
         };
         Watertight::intersect(ray, pre, &tri, cull)
     }
+
+    type Rel = RelTri4;
+    const REL_EMPTY: RelTri4 = RelTri4::EMPTY;
+
+    #[inline]
+    fn relative(&self, eye: Vec3) -> RelTri4 {
+        RelTri4 {
+            a: minus(&self.a, eye),
+            b: minus(&self.b, eye),
+            c: minus(&self.c, eye),
+        }
+    }
+
+    #[inline(always)]
+    fn test_four_rel(
+        &self,
+        rel: &RelTri4,
+        ray: &RayPacket<f32x4>,
+        pre: &Shear<f32x4>,
+        cull: Cull,
+    ) -> LaneHit<f32x4> {
+        let tri = TrianglePacket {
+            a: lanes4(&rel.a),
+            b: lanes4(&rel.b),
+            c: lanes4(&rel.c),
+        };
+        Watertight::intersect_relative(ray, pre, &tri, cull)
+    }
+
+    #[inline(always)]
+    fn test_one_rel<L: Lane>(
+        &self,
+        rel: &RelTri4,
+        k: usize,
+        rays: &RayPacket<L>,
+        pre: &Shear<L>,
+        cull: Cull,
+    ) -> LaneHit<L> {
+        let tri = TrianglePacket {
+            a: V3::splat(get(&rel.a, k)),
+            b: V3::splat(get(&rel.b, k)),
+            c: V3::splat(get(&rel.c, k)),
+        };
+        Watertight::intersect_relative(rays, pre, &tri, cull)
+    }
 }
 
 impl Packed for Sphere4 {
@@ -305,6 +405,35 @@ impl Leaf for Sphere4 {
             radius: f32x4::new(self.radius),
         };
         sphere_hit(&Robust::roots(ray, &s), cull)
+    }
+
+    type Rel = ();
+    const REL_EMPTY: () = ();
+
+    #[inline(always)]
+    fn relative(&self, _eye: Vec3) {}
+
+    #[inline(always)]
+    fn test_four_rel(
+        &self,
+        _: &(),
+        ray: &RayPacket<f32x4>,
+        pre: &(),
+        cull: Cull,
+    ) -> LaneHit<f32x4> {
+        self.test_four(ray, pre, cull)
+    }
+
+    #[inline(always)]
+    fn test_one_rel<L: Lane>(
+        &self,
+        _: &(),
+        k: usize,
+        rays: &RayPacket<L>,
+        pre: &(),
+        cull: Cull,
+    ) -> LaneHit<L> {
+        self.test_one(k, rays, pre, cull)
     }
 }
 

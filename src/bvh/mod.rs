@@ -98,13 +98,15 @@
 //! on the triangles' order; rays with `t_max = +inf` are never affected.
 
 mod build;
+pub mod focal;
 mod leaf;
 mod query;
 pub mod scene;
 mod traverse;
 
 pub use build::{build, refit};
-pub use leaf::{Leaf, Packed, Primitives, Sphere4, Tri4};
+pub use focal::{FocalBvh, FocalLeaf, FocalNode, focal_needed};
+pub use leaf::{Leaf, Packed, Primitives, RelTri4, Sphere4, Tri4};
 pub use scene::{Inst4, Instance, Scene};
 
 use crate::triangle::Cull;

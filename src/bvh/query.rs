@@ -1,5 +1,6 @@
 //! The [`Query`] implementation of the BVH: the same records as the flat sets, bit for bit.
 
+use super::traverse::{View, World};
 use super::{Bvh, LEAF_WIDTH, Leaf};
 use crate::lane::{Lane, Mask};
 use crate::query::{Hit, Hits, Query};
@@ -15,33 +16,53 @@ use crate::ray::{Ray, RayPacket};
 /// [`Robust`]: crate::sphere::Robust
 impl<P: Leaf> Query for Bvh<'_, P> {
     fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
-        let (best, win) = self.closest_lanes(rays);
-        P::records(rays, &best, self.cull, |i| {
-            // The lanes that won with primitive `i` all point at the same leaf lane.
-            let j = (0..L::LANES)
-                .find(|&j| best.mask.test(j) && best.index.as_ref().get(j) == Some(&i))?;
-            let w = *win.get(j)? as usize;
-            Some(self.leaves.get(w / LEAF_WIDTH)?.prim(w % LEAF_WIDTH))
-        })
+        closest_packet(self, &World, rays)
     }
 
     fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
-        self.any_lanes(rays)
+        self.any_lanes(&World, rays)
     }
 
     fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
-        self.all_lanes(rays, f)
+        self.all_lanes(&World, rays, f)
     }
 
     fn closest_ray(&self, ray: &Ray) -> Option<Hit> {
-        let (best, prim) = self.closest_one(ray)?;
-        P::records(&RayPacket::<f32>::splat(ray), &best, self.cull, |_| {
-            Some(prim)
-        })
-        .lane(0)
+        closest_ray(self, &World, ray)
     }
 
     fn any_ray(&self, ray: &Ray) -> bool {
-        self.any_one(ray)
+        self.any_one(&World, ray)
     }
+}
+
+/// The closest hits of a packet traversed in `view`, as records.
+#[inline]
+pub(crate) fn closest_packet<P: Leaf, V: View<P>, L: Lane>(
+    bvh: &Bvh<'_, P>,
+    view: &V,
+    rays: &RayPacket<L>,
+) -> Hits<L> {
+    let (best, win) = bvh.closest_lanes(view, rays);
+    P::records(rays, &best, bvh.cull, |i| {
+        // The lanes that won with primitive `i` all point at the same leaf lane.
+        let j =
+            (0..L::LANES).find(|&j| best.mask.test(j) && best.index.as_ref().get(j) == Some(&i))?;
+        let w = *win.get(j)? as usize;
+        Some(bvh.leaves.get(w / LEAF_WIDTH)?.prim(w % LEAF_WIDTH))
+    })
+}
+
+/// The closest hit of one ray traversed in `view`, as a record.
+#[inline]
+pub(crate) fn closest_ray<P: Leaf, V: View<P>>(
+    bvh: &Bvh<'_, P>,
+    view: &V,
+    ray: &Ray,
+) -> Option<Hit> {
+    let (best, prim) = bvh.closest_one(view, ray)?;
+    P::records(&RayPacket::<f32>::splat(ray), &best, bvh.cull, |_| {
+        Some(prim)
+    })
+    .lane(0)
 }

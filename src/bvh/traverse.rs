@@ -10,9 +10,92 @@ use crate::lane::MAX_LANES;
 use crate::lane::{Lane, Mask};
 use crate::query::Hits;
 use crate::ray::{Ray, RayPacket};
+use crate::triangle::Cull;
+
+/// Where a traversal reads the children's boxes and the leaves' geometry: the tree itself
+/// ([`World`]) or a per-eye cache ([`FocalBvh`](super::FocalBvh)).
+pub(crate) trait View<P: Leaf> {
+    /// The rows are relative to the rays' origin and widened (the per-eye cache).
+    const REL: bool;
+    /// What the kernels test for a leaf.
+    type Test<'a>: LeafTest<P>
+    where
+        Self: 'a,
+        P: 'a;
+    /// The children's boxes of node `c` (`n`).
+    fn rows<'a>(&'a self, c: u32, n: &'a Node) -> &'a [[f32; WIDTH]; 6];
+    /// What the kernels test for leaf `li` (`leaf`).
+    fn leaf<'a>(&'a self, li: u32, leaf: &'a P) -> Self::Test<'a>;
+}
+
+/// A leaf's kernel calls: 1 ray × 4 primitives and N rays × primitive `k`.
+pub(crate) trait LeafTest<P: Leaf> {
+    fn four(&self, ray: &RayPacket<f32x4>, pre: &P::Rays<f32x4>, cull: Cull) -> LaneHit<f32x4>;
+    fn one<L: Lane>(
+        &self,
+        k: usize,
+        rays: &RayPacket<L>,
+        pre: &P::Rays<L>,
+        cull: Cull,
+    ) -> LaneHit<L>;
+}
+
+impl<P: Leaf> LeafTest<P> for &P {
+    #[inline(always)]
+    fn four(&self, ray: &RayPacket<f32x4>, pre: &P::Rays<f32x4>, cull: Cull) -> LaneHit<f32x4> {
+        self.test_four(ray, pre, cull)
+    }
+    #[inline(always)]
+    fn one<L: Lane>(
+        &self,
+        k: usize,
+        rays: &RayPacket<L>,
+        pre: &P::Rays<L>,
+        cull: Cull,
+    ) -> LaneHit<L> {
+        self.test_one(k, rays, pre, cull)
+    }
+}
+
+/// The tree's own boxes and leaves.
+pub(crate) struct World;
+
+impl<P: Leaf> View<P> for World {
+    const REL: bool = false;
+    type Test<'a>
+        = &'a P
+    where
+        P: 'a;
+    #[inline(always)]
+    fn rows<'a>(&'a self, _: u32, n: &'a Node) -> &'a [[f32; WIDTH]; 6] {
+        &n.bounds
+    }
+    #[inline(always)]
+    fn leaf<'a>(&'a self, _: u32, leaf: &'a P) -> &'a P {
+        leaf
+    }
+}
+
+/// One ray's slab test of node `c` (`n`) in `view`.
+#[inline(always)]
+fn node_one<P: Leaf, V: View<P>>(
+    view: &V,
+    slab: &Slab,
+    c: u32,
+    n: &Node,
+    t_min: f32,
+    t_max: f32,
+) -> (u32, f32x8) {
+    let rows = view.rows(c, n);
+    if V::REL {
+        slab.test_rows::<true>(n, rows, t_min, t_max)
+    } else {
+        slab.test_rows::<false>(n, rows, t_min, t_max)
+    }
+}
 
 /// The box widening relative to `R + |o|∞`: `2^-14`.
-const MARGIN: f32 = 1.0 / 16384.0;
+pub(crate) const MARGIN: f32 = 1.0 / 16384.0;
 /// The largest `R + |o|∞` the slab test handles (`2^100`); beyond it every child is visited.
 const FAR: f32 = 1.2676506e30;
 /// Inverse direction components are clamped to `±2^100` (a zero component gives `±2^100`).
@@ -72,6 +155,20 @@ impl Slab {
     /// entry parameters per child.
     #[inline(always)]
     pub(crate) fn test(&self, n: &Node, t_min: f32, t_max: f32) -> (u32, f32x8) {
+        self.test_rows::<false>(n, &n.bounds, t_min, t_max)
+    }
+
+    /// [`test`](Self::test) on the boxes `b` of `n`'s children: the node's own (`REL` false),
+    /// or the per-eye rows `bounds − eye` widened by the margin (`REL` true: no subtraction,
+    /// the origins are not used).
+    #[inline(always)]
+    pub(crate) fn test_rows<const REL: bool>(
+        &self,
+        n: &Node,
+        b: &[[f32; WIDTH]; 6],
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, f32x8) {
         if self.all {
             let mut bits = 0;
             for (k, &c) in n.child.iter().enumerate() {
@@ -81,8 +178,13 @@ impl Slab {
             }
             return (bits, f32x8::splat(t_min));
         }
-        let b = &n.bounds;
-        let plane = |p: usize, o: f32, inv: f32| (f32x8::new(b[p]) - f32x8::splat(o)) * inv;
+        let plane = |p: usize, o: f32, inv: f32| {
+            if REL {
+                f32x8::new(b[p]) * inv
+            } else {
+                (f32x8::new(b[p]) - f32x8::splat(o)) * inv
+            }
+        };
         let tn = f32x8::splat(t_min)
             .fast_max(plane(self.near[0], self.on[0], self.inv[0]))
             .fast_max(plane(self.near[1], self.on[1], self.inv[1]))
@@ -180,17 +282,21 @@ struct One {
 impl<P: Leaf> Bvh<'_, P> {
     /// The closest hit of one ray (finished, as a one-lane [`Best`]) and its primitive: the
     /// brute-force answer with the same kernel, bit for bit (see the [module docs](super)).
-    pub(crate) fn closest_one(&self, ray: &Ray) -> Option<Winner<P>> {
-        match self.closest_with::<SHORT>(ray) {
+    pub(crate) fn closest_one<V: View<P>>(&self, view: &V, ray: &Ray) -> Option<Winner<P>> {
+        match self.closest_with::<SHORT, V>(view, ray) {
             Ok(h) => h,
-            Err(()) => self.closest_with::<STACK>(ray).ok().flatten(),
+            Err(()) => self.closest_with::<STACK, V>(view, ray).ok().flatten(),
         }
     }
 
     /// [`closest_one`](Self::closest_one) with a stack of `N` entries: `Err` when it
     /// overflowed (never with `N = STACK`, by the depth bound).
     #[inline(always)]
-    fn closest_with<const N: usize>(&self, ray: &Ray) -> Result<Option<Winner<P>>, ()> {
+    fn closest_with<const N: usize, V: View<P>>(
+        &self,
+        view: &V,
+        ray: &Ray,
+    ) -> Result<Option<Winner<P>>, ()> {
         if !ray.is_valid() {
             return Ok(None);
         }
@@ -217,7 +323,7 @@ impl<P: Leaf> Bvh<'_, P> {
                 let Some(n) = self.nodes.get(c as usize) else {
                     continue;
                 };
-                let (bits, tn) = slab.test(n, ray.t_min(), t_max);
+                let (bits, tn) = node_one(view, &slab, c, n, ray.t_min(), t_max);
                 stack.push_sorted(n, bits, &tn.to_array());
                 continue;
             }
@@ -229,7 +335,7 @@ impl<P: Leaf> Bvh<'_, P> {
                 t_max: f32x4::splat(t_max),
                 ..r4
             };
-            let h = leaf.test_four(&r, &pre, self.cull);
+            let h = view.leaf(li, leaf).four(&r, &pre, self.cull);
             let mut bits = h.mask.bits();
             while bits != 0 {
                 let j = bits.trailing_zeros() as usize;
@@ -263,17 +369,17 @@ impl<P: Leaf> Bvh<'_, P> {
     }
 
     /// True when one ray hits some primitive (stops at the first hit).
-    pub(crate) fn any_one(&self, ray: &Ray) -> bool {
-        match self.any_with::<SHORT>(ray) {
+    pub(crate) fn any_one<V: View<P>>(&self, view: &V, ray: &Ray) -> bool {
+        match self.any_with::<SHORT, V>(view, ray) {
             Some(hit) => hit,
-            None => self.any_with::<STACK>(ray).unwrap_or(false),
+            None => self.any_with::<STACK, V>(view, ray).unwrap_or(false),
         }
     }
 
     /// [`any_one`](Self::any_one) with a stack of `N` entries: `None` when it overflowed
     /// before finding a hit.
     #[inline(always)]
-    fn any_with<const N: usize>(&self, ray: &Ray) -> Option<bool> {
+    fn any_with<const N: usize, V: View<P>>(&self, view: &V, ray: &Ray) -> Option<bool> {
         if !ray.is_valid() {
             return Some(false);
         }
@@ -286,10 +392,14 @@ impl<P: Leaf> Bvh<'_, P> {
                 let Some(n) = self.nodes.get(c as usize) else {
                     continue;
                 };
-                let (bits, tn) = slab.test(n, ray.t_min(), ray.t_max());
+                let (bits, tn) = node_one(view, &slab, c, n, ray.t_min(), ray.t_max());
                 stack.push_sorted(n, bits, &tn.to_array());
             } else if let Some(leaf) = self.leaves.get((c & !LEAF) as usize)
-                && leaf.test_four(&r4, &pre, self.cull).mask.any()
+                && view
+                    .leaf(c & !LEAF, leaf)
+                    .four(&r4, &pre, self.cull)
+                    .mask
+                    .any()
             {
                 return Some(true);
             }
@@ -346,28 +456,43 @@ impl<L: Lane> PacketSlab<L> {
     }
 
     /// Lanes of `active` whose interval meets child `k`'s widened box, and their entry
-    /// parameters.
+    /// parameters (`b`: the node's boxes, or with `REL` the per-eye rows, as
+    /// [`Slab::test_rows`]).
     #[inline(always)]
-    fn test(&self, n: &Node, k: usize, t_min: L, t_max: L, active: L::Mask) -> (L::Mask, L) {
-        let p = |i: usize| L::from_f32(n.bounds[i][k]);
+    fn test<const REL: bool>(
+        &self,
+        b: &[[f32; WIDTH]; 6],
+        k: usize,
+        t_min: L,
+        t_max: L,
+        active: L::Mask,
+    ) -> (L::Mask, L) {
+        let p = |i: usize| L::from_f32(b[i][k]);
         let mut tn = t_min;
         let mut tf = t_max;
         for a in 0..3 {
             let (lo, hi) = (p(a), p(3 + a));
             let near = L::select(self.neg[a], hi, lo);
             let far = L::select(self.neg[a], lo, hi);
-            tn = lmax(tn, (near - self.on[a]) * self.inv[a]);
-            tf = lmin(tf, (far - self.of[a]) * self.inv[a]);
+            if REL {
+                tn = lmax(tn, near * self.inv[a]);
+                tf = lmin(tf, far * self.inv[a]);
+            } else {
+                tn = lmax(tn, (near - self.on[a]) * self.inv[a]);
+                tf = lmin(tf, (far - self.of[a]) * self.inv[a]);
+            }
         }
         ((tn.le(tf) | self.all) & active, tn)
     }
 }
 
-/// Pushes the children of `n` some lane of `active` enters, nearest (by the first such lane's
-/// entry) on top.
+/// Pushes the children of node `c` (`n`) some lane of `active` enters, nearest (by the first
+/// such lane's entry) on top.
 #[inline(always)]
-fn visit<L: Lane>(
+fn visit<P: Leaf, V: View<P>, L: Lane>(
+    view: &V,
     stack: &mut Stack,
+    c: u32,
     n: &Node,
     slab: &PacketSlab<L>,
     r: &RayPacket<L>,
@@ -375,11 +500,16 @@ fn visit<L: Lane>(
 ) {
     let mut bits = 0u32;
     let mut key = [0.0f32; WIDTH];
+    let rows = view.rows(c, n);
     for (k, key) in key.iter_mut().enumerate() {
         if n.child[k] == EMPTY {
             continue;
         }
-        let (m, tn) = slab.test(n, k, r.t_min, r.t_max, active);
+        let (m, tn) = if V::REL {
+            slab.test::<true>(rows, k, r.t_min, r.t_max, active)
+        } else {
+            slab.test::<false>(rows, k, r.t_min, r.t_max, active)
+        };
         let mb = m.bits();
         if mb != 0 {
             bits |= 1 << k;
@@ -400,8 +530,9 @@ impl<P: Leaf> Bvh<'_, P> {
     /// The closest hit of each ray lane (finished) and where each lane's winner sits
     /// (`4·leaf + lane`): the brute-force answer with the same kernel, bit for bit, at every
     /// width (see the [module docs](super)).
-    pub(crate) fn closest_lanes<L: Lane>(
+    pub(crate) fn closest_lanes<V: View<P>, L: Lane>(
         &self,
+        view: &V,
         rays: &RayPacket<L>,
     ) -> (Best<L>, [u32; MAX_LANES]) {
         crate::lane::assert_fits::<L>();
@@ -422,7 +553,7 @@ impl<P: Leaf> Bvh<'_, P> {
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
-                    visit(&mut stack, n, &slab, &r, valid);
+                    visit(view, &mut stack, c, n, &slab, &r, valid);
                 }
                 continue;
             }
@@ -430,11 +561,12 @@ impl<P: Leaf> Bvh<'_, P> {
             let Some(leaf) = self.leaves.get(li as usize) else {
                 continue;
             };
+            let test = view.leaf(li, leaf);
             for (k, &index) in leaf.indices().iter().enumerate() {
                 if index == EMPTY {
                     continue;
                 }
-                let h = leaf.test_one(k, &r, &pre, self.cull);
+                let h = test.one(k, &r, &pre, self.cull);
                 if h.mask.none() {
                     continue;
                 }
@@ -468,7 +600,7 @@ impl<P: Leaf> Bvh<'_, P> {
     }
 
     /// Lanes whose ray hits some primitive (occlusion); stops when every valid lane has hit.
-    pub(crate) fn any_lanes<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
+    pub(crate) fn any_lanes<V: View<P>, L: Lane>(&self, view: &V, rays: &RayPacket<L>) -> L::Mask {
         let valid = rays.valid();
         let mut hit = L::Mask::splat(false);
         if valid.none() {
@@ -481,16 +613,17 @@ impl<P: Leaf> Bvh<'_, P> {
             let active = valid.and_not(hit);
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
-                    visit(&mut stack, n, &slab, rays, active);
+                    visit(view, &mut stack, c, n, &slab, rays, active);
                 }
                 continue;
             }
             let Some(leaf) = self.leaves.get((c & !LEAF) as usize) else {
                 continue;
             };
+            let test = view.leaf(c & !LEAF, leaf);
             for (k, &index) in leaf.indices().iter().enumerate() {
                 if index != EMPTY {
-                    hit = hit | (leaf.test_one(k, rays, &pre, self.cull).mask & valid);
+                    hit = hit | (test.one(k, rays, &pre, self.cull).mask & valid);
                 }
             }
             if valid.and_not(hit).none() {
@@ -502,7 +635,12 @@ impl<P: Leaf> Bvh<'_, P> {
 
     /// Every hit, as the flat set's `all` reports each primitive's, in traversal order (leaves
     /// nearest-first by the first lane's entry, lanes of a leaf in order).
-    pub(crate) fn all_lanes<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
+    pub(crate) fn all_lanes<V: View<P>, L: Lane>(
+        &self,
+        view: &V,
+        rays: &RayPacket<L>,
+        f: &mut dyn FnMut(&Hits<L>),
+    ) {
         let valid = rays.valid();
         if valid.none() {
             return;
@@ -513,18 +651,19 @@ impl<P: Leaf> Bvh<'_, P> {
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
-                    visit(&mut stack, n, &slab, rays, valid);
+                    visit(view, &mut stack, c, n, &slab, rays, valid);
                 }
                 continue;
             }
             let Some(leaf) = self.leaves.get((c & !LEAF) as usize) else {
                 continue;
             };
+            let test = view.leaf(c & !LEAF, leaf);
             for (k, &index) in leaf.indices().iter().enumerate() {
                 if index == EMPTY {
                     continue;
                 }
-                if leaf.test_one(k, rays, &pre, self.cull).mask.any() {
+                if test.one(k, rays, &pre, self.cull).mask.any() {
                     P::all(&leaf.prim(k), index, rays, self.cull, f);
                 }
             }

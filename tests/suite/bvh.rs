@@ -20,7 +20,7 @@ use raylane::{Hit, Lane, Mask, Query, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
 /// A tree over `p` in owned vectors trimmed to what the build used.
-fn owned<P: Primitives + ?Sized>(p: &P) -> (Vec<Node>, Vec<P::Leaf>) {
+pub(crate) fn owned<P: Primitives + ?Sized>(p: &P) -> (Vec<Node>, Vec<P::Leaf>) {
     let need = bvh::needed(p.count());
     let mut nodes = vec![Node::EMPTY; need.nodes];
     let mut leaves = vec![P::Leaf::EMPTY; need.leaves];
@@ -34,7 +34,7 @@ fn owned<P: Primitives + ?Sized>(p: &P) -> (Vec<Node>, Vec<P::Leaf>) {
     (nodes, leaves)
 }
 
-fn v3(rng: &mut SmallRng, s: f32) -> Vec3 {
+pub(crate) fn v3(rng: &mut SmallRng, s: f32) -> Vec3 {
     Vec3::new(
         rng.random_range(-s..s),
         rng.random_range(-s..s),
@@ -44,7 +44,7 @@ fn v3(rng: &mut SmallRng, s: f32) -> Vec3 {
 
 /// Random rays at a scene in `[-1, 1]^3`: half aimed at `aim` points (so they hit), some with
 /// finite or negative interval ends.
-fn rays(rng: &mut SmallRng, n: usize, aim: &[Vec3]) -> Vec<Ray> {
+pub(crate) fn rays(rng: &mut SmallRng, n: usize, aim: &[Vec3]) -> Vec<Ray> {
     (0..n)
         .map(|i| {
             let o = v3(rng, 3.0);
@@ -83,7 +83,7 @@ fn packets_of<L: Lane<Scalar = f32>>(rays: &[Ray], tree: &impl Query, flat: &imp
 
 /// The tree against the flat set on every ray: one-ray `closest`/`any` and packets of 1, 4,
 /// 8, 16 rays, bit for bit. Returns the number of hits.
-fn check(tree: &impl Query, flat: &impl Query, rays: &[Ray]) -> usize {
+pub(crate) fn check(tree: &impl Query, flat: &impl Query, rays: &[Ray]) -> usize {
     let mut hits = 0;
     for (i, r) in rays.iter().enumerate() {
         let want = flat.closest(r);
@@ -99,9 +99,22 @@ fn check(tree: &impl Query, flat: &impl Query, rays: &[Ray]) -> usize {
 }
 
 /// Checks a triangle set against brute force on `rays`; returns the hit count.
+/// Also in focal mode: the tree focused on each of the first 300 rays' origins answers that
+/// ray as brute force does.
 fn check_tris(tris: &[Triangle], rays: &[Ray]) -> usize {
     let (nodes, leaves) = owned(tris);
     let tree = Bvh::from_parts(&nodes, &leaves).expect("a valid tree");
+    let mut fnodes = vec![bvh::FocalNode::EMPTY; nodes.len()];
+    let mut fleaves = vec![bvh::FocalLeaf::EMPTY; leaves.len()];
+    for r in rays.iter().take(300) {
+        let focal = tree.focus(r.origin(), &mut fnodes, &mut fleaves).unwrap();
+        assert_eq!(
+            bits(focal.closest(r)),
+            bits(tris.closest(r)),
+            "focal: {r:?}"
+        );
+        assert_eq!(focal.any(r), tris.any(r), "focal any: {r:?}");
+    }
     check(&tree, &tris, rays)
 }
 
@@ -112,11 +125,11 @@ fn check_spheres(spheres: &[Sphere], rays: &[Ray]) -> usize {
 }
 
 /// A mesh's triangles as a flat set (the reference).
-fn flat(mesh: &Mesh) -> Vec<Triangle> {
+pub(crate) fn flat(mesh: &Mesh) -> Vec<Triangle> {
     (0..mesh.len()).map(|i| mesh.triangle(i).unwrap()).collect()
 }
 
-fn soup(rng: &mut SmallRng, n: usize) -> Vec<Triangle> {
+pub(crate) fn soup(rng: &mut SmallRng, n: usize) -> Vec<Triangle> {
     (0..n)
         .map(|_| {
             let a = v3(rng, 1.0);
@@ -126,7 +139,7 @@ fn soup(rng: &mut SmallRng, n: usize) -> Vec<Triangle> {
         .collect()
 }
 
-fn centroids(tris: &[Triangle]) -> Vec<Vec3> {
+pub(crate) fn centroids(tris: &[Triangle]) -> Vec<Vec3> {
     tris.iter()
         .filter(|t| t.is_valid())
         .map(|t| (t.a() + t.b() + t.c()) / 3.0)
