@@ -9,7 +9,7 @@ use std::time::Instant;
 
 use glam::Vec3;
 use raylane::Pinhole;
-use raylane::bvh::{self, Bvh, Node, Scratch, Tri4};
+use raylane::bvh::{self, Bvh, FocalLeaf, FocalNode, Node, Scratch, Tri4};
 use raylane::mesh::Mesh;
 use raylane::{Lane, Mask, Query};
 use wide::{f32x4, f32x8, f32x16};
@@ -106,6 +106,37 @@ fn packet<L: Lane<Scalar = f32>>(tree: &Bvh<Tri4>, cam: &Pinhole) -> (f64, f64) 
     run::<L>(cam, |p| tree.closest(p).mask.bits().count_ones())
 }
 
+/// Rays per second through a [`FocalBvh`] focused on the camera's eye, the focus (every node's
+/// planes, and the leaves filled lazily) counted in every frame; and the leaves filled.
+fn focal<L: Lane<Scalar = f32>>(
+    tree: &Bvh<Tri4>,
+    cam: &Pinhole,
+    fnodes: &mut [FocalNode],
+    fleaves: &mut [FocalLeaf<Tri4>],
+) -> (f64, usize) {
+    let mut best = f64::INFINITY;
+    let mut filled = 0;
+    for _ in 0..3 {
+        let t = Instant::now();
+        let f = tree.focus(cam.eye, fnodes, fleaves).unwrap();
+        let mut hits = 0u32;
+        for y in 0..cam.height {
+            for x in (0..cam.width).step_by(L::LANES) {
+                let p = cam.row_packet::<L>(x, y);
+                hits += if L::LANES == 1 {
+                    f.closest(&p.ray(0)).is_some() as u32
+                } else {
+                    f.closest(&p).mask.bits().count_ones()
+                };
+            }
+        }
+        best = best.min(t.elapsed().as_secs_f64());
+        filled = f.filled();
+        std::hint::black_box(hits);
+    }
+    ((cam.width * cam.height) as f64 / best / 1e6, filled)
+}
+
 fn main() {
     let mut models = vec![load_bin(
         "vendored bunny",
@@ -124,6 +155,7 @@ fn main() {
     println!(
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |"
     );
+    let mut focal_rows = Vec::new();
     for m in &models {
         let mesh = Mesh::new(&m.pos, &m.idx);
         let need = bvh::needed(m.idx.len());
@@ -167,6 +199,18 @@ fn main() {
                 x8 / flat
             );
         }
+        let (fn_, fl) = bvh::focal_needed(&tree);
+        let mut fnodes = vec![FocalNode::EMPTY; fn_];
+        let mut fleaves = vec![FocalLeaf::EMPTY; fl];
+        let (f1, filled) = focal::<f32>(&tree, &cam, &mut fnodes, &mut fleaves);
+        let (f4, _) = focal::<f32x4>(&tree, &cam, &mut fnodes, &mut fleaves);
+        let (f8, _) = focal::<f32x8>(&tree, &cam, &mut fnodes, &mut fleaves);
+        let (f16, _) = focal::<f32x16>(&tree, &cam, &mut fnodes, &mut fleaves);
+        focal_rows.push(format!(
+            "| {} | {single:.2} | {f1:.2} | {x4:.2} | {f4:.2} | {x8:.2} | {f8:.2} | {x16:.2} | {f16:.2} | {filled} of {} |",
+            m.name,
+            st.leaves
+        ));
         println!(
             "| {} | {} | {:.1} | {:.1} | {} | {} | {} | {:.1} | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} | {:.1} |",
             m.name,
@@ -184,5 +228,12 @@ fn main() {
             any1,
             frac * 100.0
         );
+    }
+    println!(
+        "\nFocal mode (focus counted in every frame), Mrays/s:\n\n| mesh | 1 ray | focal | x4 | focal x4 | x8 | focal x8 | x16 | focal x16 | leaves filled |"
+    );
+    println!("| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    for r in &focal_rows {
+        println!("{r}");
     }
 }

@@ -40,16 +40,17 @@
 use core::cell::Cell;
 
 use glam::Vec3;
-use wide::f32x4;
+use wide::{f32x4, f32x8};
 
 use super::query::{closest_packet, closest_ray};
-use super::traverse::{LeafTest, MARGIN, View, World};
-use super::{BuildError, Bvh, Leaf, Node, WIDTH};
+use super::traverse::{LeafTest, MARGIN, PacketSlab, Slab, View, World, lmax, lmin};
+use super::{BuildError, Bvh, EMPTY, Leaf, Node, WIDTH};
 use crate::hit::LaneHit;
 use crate::lane::{Lane, Mask, Scalar};
 use crate::query::{Hit, Hits, Query};
 use crate::ray::{Ray, RayPacket};
 use crate::triangle::Cull;
+use crate::vec3::V3;
 
 /// The per-eye planes of one node's children: rows as [`Node::bounds`] (minimum x, y, z,
 /// maximum x, y, z; `[axis][child]`), minus the eye and widened by the margin. 192 bytes.
@@ -71,6 +72,131 @@ impl Default for FocalNode {
     fn default() -> Self {
         FocalNode::EMPTY
     }
+}
+
+/// What a per-eye cache keeps of a node: [`FocalNode`] (the children's planes minus the eye,
+/// the slab test without subtractions; the default) or [`SphereNode`] (the lecture's focal
+/// sphere test, kept for the measurement).
+pub trait NodeCache: Copy + core::fmt::Debug {
+    /// An entry not yet computed.
+    const EMPTY: Self;
+    /// The entry of `n` for the eye `e` and the margin `m`.
+    fn make(n: &Node, e: [f32; 3], m: f32) -> Self;
+    /// The cached rows, by kind.
+    #[doc(hidden)]
+    fn rows(&self) -> NodeRows<'_>;
+}
+
+/// The rows of a [`NodeCache`] entry, by kind.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug)]
+pub enum NodeRows<'a> {
+    /// [`FocalNode::rows`].
+    Boxes(&'a [[f32; WIDTH]; 6]),
+    /// [`SphereNode::rows`].
+    Spheres(&'a [[f32; WIDTH]; 5]),
+}
+
+impl NodeCache for FocalNode {
+    const EMPTY: Self = FocalNode::EMPTY;
+    fn make(n: &Node, e: [f32; 3], m: f32) -> Self {
+        let mut f = FocalNode::EMPTY;
+        for a in 0..3 {
+            f.rows[a] = n.bounds[a].map(|b| (b - e[a]) - m);
+            f.rows[3 + a] = n.bounds[3 + a].map(|b| (b - e[a]) + m);
+        }
+        f
+    }
+    #[inline(always)]
+    fn rows(&self) -> NodeRows<'_> {
+        NodeRows::Boxes(&self.rows)
+    }
+}
+
+/// The lecture's focal sphere test per child (measured against [`FocalNode`], not the
+/// default): the sphere around the child's box, centre minus the eye `c`, radius `r` and
+/// `k = |c|² − r²` cached; per ray `|d|` and `1/|d|²`; a child is entered when
+/// `!((d·c)² < k·|d|²)` (4 mul, 2 add and a compare for unit directions, one more mul
+/// otherwise), between `(d·c ∓ r·|d|)/|d|²` (2 mul, 2 add). Conservative: `r` is the
+/// half-diagonal plus the margin, enlarged by `2^-10·|c|` to cover the roundings of the
+/// squares (a non-finite value visits the child).
+#[repr(C, align(32))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SphereNode {
+    /// `c` (x, y, z), `r`, `k` per child; empty slots have `k = +inf`.
+    pub rows: [[f32; WIDTH]; 5],
+}
+
+impl NodeCache for SphereNode {
+    const EMPTY: Self = SphereNode {
+        rows: [[0.0; WIDTH]; 5],
+    };
+    fn make(n: &Node, e: [f32; 3], m: f32) -> Self {
+        let mut s = SphereNode {
+            rows: [[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]; 5],
+        };
+        for k in 0..WIDTH {
+            let lo = [0, 1, 2].map(|a| f64::from(n.bounds[a][k]));
+            let hi = [3, 4, 5].map(|a| f64::from(n.bounds[a][k]));
+            let c = [0, 1, 2].map(|a| (lo[a] + hi[a]) * 0.5 - f64::from(e[a]));
+            let h2: f64 = (0..3)
+                .map(|a| (hi[a] - lo[a]) * (hi[a] - lo[a]) * 0.25)
+                .sum();
+            let cc: f64 = c.iter().map(|x| x * x).sum();
+            let r =
+                (libm::sqrt(h2) + f64::from(m)) * (1.0 + 1.0 / 65536.0) + libm::sqrt(cc) / 1024.0;
+            let kk = cc - r * r;
+            let empty = n.child[k] == EMPTY || !(lo[0] <= hi[0]);
+            for a in 0..3 {
+                s.rows[a][k] = if empty { 0.0 } else { c[a] as f32 };
+            }
+            s.rows[3][k] = if empty { 0.0 } else { r as f32 };
+            s.rows[4][k] = if empty { f32::INFINITY } else { kk as f32 };
+        }
+        s
+    }
+    #[inline(always)]
+    fn rows(&self) -> NodeRows<'_> {
+        NodeRows::Spheres(&self.rows)
+    }
+}
+
+/// One ray against a [`SphereNode`]'s children (`x`: `|d|`, `1/|d|²`).
+#[inline(always)]
+fn spheres_one(
+    r: &[[f32; WIDTH]; 5],
+    x: (f32, f32),
+    d: [f32; 3],
+    t_min: f32,
+    t_max: f32,
+) -> (u32, f32x8) {
+    let b = f32x8::new(r[0]) * d[0] + f32x8::new(r[1]) * d[1] + f32x8::new(r[2]) * d[2];
+    let dd = 1.0 / x.1;
+    let hit = !(b * b).simd_lt(f32x8::new(r[4]) * dd);
+    let rd = f32x8::new(r[3]) * x.0;
+    let tn = f32x8::splat(t_min).fast_max((b - rd) * x.1);
+    let tf = f32x8::splat(t_max).fast_min((b + rd) * x.1);
+    ((hit & tn.simd_le(tf)).to_bitmask(), tn)
+}
+
+/// Packet lanes against child `k` of a [`SphereNode`] (`x`: `|d|`, `1/|d|²` per lane).
+#[inline(always)]
+fn spheres_many<L: Lane>(
+    r: &[[f32; WIDTH]; 5],
+    k: usize,
+    x: (L, L),
+    d: V3<L>,
+    t_min: L,
+    t_max: L,
+) -> (L::Mask, L) {
+    let p = |i: usize| L::from_f32(r[i][k]);
+    let b = d.x * p(0) + d.y * p(1) + d.z * p(2);
+    let dd = L::from_f32(1.0) / x.1;
+    let hit = !(b * b).lt(p(4) * dd);
+    let rd = p(3) * x.0;
+    let tn = lmax(t_min, (b - rd) * x.1);
+    let tf = lmin(t_max, (b + rd) * x.1);
+    (hit & tn.le(tf), tn)
 }
 
 /// The per-eye cache entry of one leaf: filled the first time a ray from the eye reaches it.
@@ -112,16 +238,16 @@ impl<P: Leaf> core::fmt::Debug for FocalLeaf<P> {
 
 /// A tree with a per-eye cache: answers every [`Query`] as the tree itself does, bit for
 /// bit, faster for rays from the eye (see [`focal`](self)). Made by [`Bvh::focus`].
-pub struct FocalBvh<'s, 'c, P: Leaf> {
+pub struct FocalBvh<'s, 'c, P: Leaf, N: NodeCache = FocalNode> {
     bvh: Bvh<'s, P>,
     eye: Vec3,
     /// The eye is finite (otherwise every query runs in the world mode).
     on: bool,
-    nodes: &'c [FocalNode],
+    nodes: &'c [N],
     leaves: &'c [Cell<FocalLeaf<P>>],
 }
 
-impl<P: Leaf> core::fmt::Debug for FocalBvh<'_, '_, P> {
+impl<P: Leaf, N: NodeCache> core::fmt::Debug for FocalBvh<'_, '_, P, N> {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.debug_struct("FocalBvh")
             .field("eye", &self.eye)
@@ -151,6 +277,17 @@ impl<'s, P: Leaf> Bvh<'s, P> {
         nodes: &'c mut [FocalNode],
         leaves: &'c mut [FocalLeaf<P>],
     ) -> Result<FocalBvh<'s, 'c, P>, BuildError> {
+        self.focus_with(eye, nodes, leaves)
+    }
+
+    /// [`focus`](Self::focus) with another node cache ([`SphereNode`]: the lecture's focal
+    /// sphere test, for measurements).
+    pub fn focus_with<'c, N: NodeCache>(
+        &self,
+        eye: Vec3,
+        nodes: &'c mut [N],
+        leaves: &'c mut [FocalLeaf<P>],
+    ) -> Result<FocalBvh<'s, 'c, P, N>, BuildError> {
         let (nn, nl) = focal_needed(self);
         if nodes.len() < nn {
             return Err(BuildError::Nodes(nn));
@@ -164,10 +301,7 @@ impl<'s, P: Leaf> Bvh<'s, P> {
             let e = eye.to_array();
             let m = (self.reach + eye.abs().max_element()) * MARGIN;
             for (f, n) in nodes.iter_mut().zip(self.nodes) {
-                for a in 0..3 {
-                    f.rows[a] = n.bounds[a].map(|b| (b - e[a]) - m);
-                    f.rows[3 + a] = n.bounds[3 + a].map(|b| (b - e[a]) + m);
-                }
+                *f = N::make(n, e, m);
             }
         }
         leaves.fill(FocalLeaf::EMPTY);
@@ -181,7 +315,7 @@ impl<'s, P: Leaf> Bvh<'s, P> {
     }
 }
 
-impl<'s, P: Leaf> FocalBvh<'s, '_, P> {
+impl<'s, P: Leaf, N: NodeCache> FocalBvh<'s, '_, P, N> {
     /// The eye.
     #[must_use]
     pub fn eye(&self) -> Vec3 {
@@ -241,29 +375,74 @@ impl<P: Leaf> LeafTest<P> for RelLeaf<'_, P> {
     }
 }
 
-/// Rows that admit every ray (only for a node index beyond the cache, which `focus` rules
-/// out): still exact, only slower.
-const OPEN: [[f32; WIDTH]; 6] = [
-    [f32::NEG_INFINITY; WIDTH],
-    [f32::NEG_INFINITY; WIDTH],
-    [f32::NEG_INFINITY; WIDTH],
-    [f32::INFINITY; WIDTH],
-    [f32::INFINITY; WIDTH],
-    [f32::INFINITY; WIDTH],
-];
-
-impl<P: Leaf> View<P> for FocalBvh<'_, '_, P> {
-    const REL: bool = true;
+impl<P: Leaf, N: NodeCache> View<P> for FocalBvh<'_, '_, P, N> {
+    /// `|d|` and `1/|d|²` for [`SphereNode`]s.
+    type One = (f32, f32);
+    type Many<L: Lane> = (L, L);
+    #[inline(always)]
+    fn one(&self, ray: &Ray) -> (f32, f32) {
+        match N::EMPTY.rows() {
+            NodeRows::Boxes(_) => (0.0, 0.0),
+            NodeRows::Spheres(_) => {
+                let dd = ray.dir().length_squared();
+                (libm::sqrtf(dd), 1.0 / dd)
+            }
+        }
+    }
+    #[inline(always)]
+    fn many<L: Lane>(&self, rays: &RayPacket<L>) -> (L, L) {
+        match N::EMPTY.rows() {
+            NodeRows::Boxes(_) => (L::from_f32(0.0), L::from_f32(0.0)),
+            NodeRows::Spheres(_) => {
+                let dd = rays.dir.length_squared();
+                (dd.sqrt(), L::from_f32(1.0) / dd)
+            }
+        }
+    }
+    /// A node index beyond the cache (which `focus` rules out) is tested by its own boxes, as
+    /// is every node for a ray whose slab test visits every child.
+    #[inline(always)]
+    fn node_one(
+        &self,
+        x: &(f32, f32),
+        slab: &Slab,
+        c: u32,
+        n: &Node,
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, f32x8) {
+        match self.nodes.get(c as usize).map(N::rows) {
+            Some(NodeRows::Boxes(r)) => slab.test_rows::<true>(n, r, t_min, t_max),
+            Some(NodeRows::Spheres(r)) if !slab.all => spheres_one(r, *x, slab.dir(), t_min, t_max),
+            _ => slab.test_rows::<false>(n, &n.bounds, t_min, t_max),
+        }
+    }
+    #[inline(always)]
+    fn node_many<L: Lane>(
+        &self,
+        x: &(L, L),
+        slab: &PacketSlab<L>,
+        c: u32,
+        n: &Node,
+        k: usize,
+        t_min: L,
+        t_max: L,
+        active: L::Mask,
+    ) -> (L::Mask, L) {
+        match self.nodes.get(c as usize).map(N::rows) {
+            Some(NodeRows::Boxes(r)) => slab.test::<true>(r, k, t_min, t_max, active),
+            Some(NodeRows::Spheres(r)) => {
+                let (m, tn) = spheres_many(r, k, *x, slab.dir(), t_min, t_max);
+                ((m | slab.all) & active, tn)
+            }
+            None => slab.test::<false>(&n.bounds, k, t_min, t_max, active),
+        }
+    }
     type Test<'a>
         = RelLeaf<'a, P>
     where
         Self: 'a,
         P: 'a;
-
-    #[inline(always)]
-    fn rows<'a>(&'a self, c: u32, _: &'a Node) -> &'a [[f32; WIDTH]; 6] {
-        self.nodes.get(c as usize).map_or(&OPEN, |f| &f.rows)
-    }
 
     #[inline(always)]
     fn leaf<'a>(&'a self, li: u32, leaf: &'a P) -> RelLeaf<'a, P> {
@@ -284,7 +463,7 @@ impl<P: Leaf> View<P> for FocalBvh<'_, '_, P> {
 
 /// Answers as the tree does ([`Bvh`]'s [`Query`]), bit for bit; rays from the eye use the
 /// cache.
-impl<P: Leaf> Query for FocalBvh<'_, '_, P> {
+impl<P: Leaf, N: NodeCache> Query for FocalBvh<'_, '_, P, N> {
     fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
         if self.from_eye(rays) {
             closest_packet(&self.bvh, self, rays)

@@ -105,7 +105,7 @@ pub mod scene;
 mod traverse;
 
 pub use build::{build, refit};
-pub use focal::{FocalBvh, FocalLeaf, FocalNode, focal_needed};
+pub use focal::{FocalBvh, FocalLeaf, FocalNode, NodeCache, NodeRows, SphereNode, focal_needed};
 pub use leaf::{Leaf, Packed, Primitives, RelTri4, Sphere4, Tri4};
 pub use scene::{Inst4, Instance, Scene};
 

@@ -11,19 +11,49 @@ use crate::lane::{Lane, Mask};
 use crate::query::Hits;
 use crate::ray::{Ray, RayPacket};
 use crate::triangle::Cull;
+use crate::vec3::V3;
 
 /// Where a traversal reads the children's boxes and the leaves' geometry: the tree itself
 /// ([`World`]) or a per-eye cache ([`FocalBvh`](super::FocalBvh)).
 pub(crate) trait View<P: Leaf> {
-    /// The rows are relative to the rays' origin and widened (the per-eye cache).
-    const REL: bool;
+    /// Per-ray constants of the node test beyond the slab's, for one ray.
+    type One: Copy;
+    /// The same for a packet.
+    type Many<L: Lane>: Copy;
+    /// The node test's constants for `ray`.
+    fn one(&self, ray: &Ray) -> Self::One;
+    /// The node test's constants for `rays`.
+    fn many<L: Lane>(&self, rays: &RayPacket<L>) -> Self::Many<L>;
+    /// One ray against the children of node `c` (`n`): the bits of the children its interval
+    /// meets and their entry parameters.
+    fn node_one(
+        &self,
+        x: &Self::One,
+        slab: &Slab,
+        c: u32,
+        n: &Node,
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, f32x8);
+    /// The lanes of `active` whose interval meets child `k` of node `c` (`n`), and their
+    /// entry parameters.
+    #[allow(clippy::too_many_arguments)]
+    fn node_many<L: Lane>(
+        &self,
+        x: &Self::Many<L>,
+        slab: &PacketSlab<L>,
+        c: u32,
+        n: &Node,
+        k: usize,
+        t_min: L,
+        t_max: L,
+        active: L::Mask,
+    ) -> (L::Mask, L);
     /// What the kernels test for a leaf.
     type Test<'a>: LeafTest<P>
     where
         Self: 'a,
         P: 'a;
-    /// The children's boxes of node `c` (`n`).
-    fn rows<'a>(&'a self, c: u32, n: &'a Node) -> &'a [[f32; WIDTH]; 6];
     /// What the kernels test for leaf `li` (`leaf`).
     fn leaf<'a>(&'a self, li: u32, leaf: &'a P) -> Self::Test<'a>;
 }
@@ -61,36 +91,45 @@ impl<P: Leaf> LeafTest<P> for &P {
 pub(crate) struct World;
 
 impl<P: Leaf> View<P> for World {
-    const REL: bool = false;
+    type One = ();
+    type Many<L: Lane> = ();
+    #[inline(always)]
+    fn one(&self, _: &Ray) {}
+    #[inline(always)]
+    fn many<L: Lane>(&self, _: &RayPacket<L>) {}
+    #[inline(always)]
+    fn node_one(
+        &self,
+        _: &(),
+        slab: &Slab,
+        _: u32,
+        n: &Node,
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, f32x8) {
+        slab.test_rows::<false>(n, &n.bounds, t_min, t_max)
+    }
+    #[inline(always)]
+    fn node_many<L: Lane>(
+        &self,
+        _: &(),
+        slab: &PacketSlab<L>,
+        _: u32,
+        n: &Node,
+        k: usize,
+        t_min: L,
+        t_max: L,
+        active: L::Mask,
+    ) -> (L::Mask, L) {
+        slab.test::<false>(&n.bounds, k, t_min, t_max, active)
+    }
     type Test<'a>
         = &'a P
     where
         P: 'a;
     #[inline(always)]
-    fn rows<'a>(&'a self, _: u32, n: &'a Node) -> &'a [[f32; WIDTH]; 6] {
-        &n.bounds
-    }
-    #[inline(always)]
     fn leaf<'a>(&'a self, _: u32, leaf: &'a P) -> &'a P {
         leaf
-    }
-}
-
-/// One ray's slab test of node `c` (`n`) in `view`.
-#[inline(always)]
-fn node_one<P: Leaf, V: View<P>>(
-    view: &V,
-    slab: &Slab,
-    c: u32,
-    n: &Node,
-    t_min: f32,
-    t_max: f32,
-) -> (u32, f32x8) {
-    let rows = view.rows(c, n);
-    if V::REL {
-        slab.test_rows::<true>(n, rows, t_min, t_max)
-    } else {
-        slab.test_rows::<false>(n, rows, t_min, t_max)
     }
 }
 
@@ -113,11 +152,18 @@ pub(crate) struct Slab {
     on: [f32; 3],
     of: [f32; 3],
     inv: [f32; 3],
+    dir: [f32; 3],
     /// Visit every non-empty child (the slab test's range is exceeded).
-    all: bool,
+    pub(crate) all: bool,
 }
 
 impl Slab {
+    /// The ray's direction.
+    #[inline(always)]
+    pub(crate) fn dir(&self) -> [f32; 3] {
+        self.dir
+    }
+
     pub(crate) fn new(o: Vec3, d: Vec3, reach: f32) -> Self {
         let (o, d) = (o.to_array(), d.to_array());
         let omax = o[0].abs().max(o[1].abs()).max(o[2].abs());
@@ -131,6 +177,7 @@ impl Slab {
             on: [0.0; 3],
             of: [0.0; 3],
             inv: [0.0; 3],
+            dir: d,
             all,
         };
         for a in 0..3 {
@@ -301,6 +348,7 @@ impl<P: Leaf> Bvh<'_, P> {
             return Ok(None);
         }
         let slab = Slab::new(ray.origin(), ray.dir(), self.reach);
+        let x = view.one(ray);
         let r4 = RayPacket::<f32x4>::splat(ray);
         let pre = P::prepare(&r4);
         let t_end = ray.t_max();
@@ -323,7 +371,7 @@ impl<P: Leaf> Bvh<'_, P> {
                 let Some(n) = self.nodes.get(c as usize) else {
                     continue;
                 };
-                let (bits, tn) = node_one(view, &slab, c, n, ray.t_min(), t_max);
+                let (bits, tn) = view.node_one(&x, &slab, c, n, ray.t_min(), t_max);
                 stack.push_sorted(n, bits, &tn.to_array());
                 continue;
             }
@@ -384,6 +432,7 @@ impl<P: Leaf> Bvh<'_, P> {
             return Some(false);
         }
         let slab = Slab::new(ray.origin(), ray.dir(), self.reach);
+        let x = view.one(ray);
         let r4 = RayPacket::<f32x4>::splat(ray);
         let pre = P::prepare(&r4);
         let mut stack = Stack::<N>::new();
@@ -392,7 +441,7 @@ impl<P: Leaf> Bvh<'_, P> {
                 let Some(n) = self.nodes.get(c as usize) else {
                     continue;
                 };
-                let (bits, tn) = node_one(view, &slab, c, n, ray.t_min(), ray.t_max());
+                let (bits, tn) = view.node_one(&x, &slab, c, n, ray.t_min(), ray.t_max());
                 stack.push_sorted(n, bits, &tn.to_array());
             } else if let Some(leaf) = self.leaves.get((c & !LEAF) as usize)
                 && view
@@ -410,25 +459,32 @@ impl<P: Leaf> Bvh<'_, P> {
 
 /// The per-lane constants of the slab test for a packet (as [`Slab`], lane by lane).
 #[derive(Clone, Copy, Debug)]
-struct PacketSlab<L: Lane> {
+pub(crate) struct PacketSlab<L: Lane> {
     neg: [L::Mask; 3],
     on: [L; 3],
     of: [L; 3],
     inv: [L; 3],
-    all: L::Mask,
+    dir: V3<L>,
+    pub(crate) all: L::Mask,
 }
 
 #[inline(always)]
-fn lmax<L: Lane>(a: L, b: L) -> L {
+pub(crate) fn lmax<L: Lane>(a: L, b: L) -> L {
     L::select(b.gt(a), b, a)
 }
 
 #[inline(always)]
-fn lmin<L: Lane>(a: L, b: L) -> L {
+pub(crate) fn lmin<L: Lane>(a: L, b: L) -> L {
     L::select(b.lt(a), b, a)
 }
 
 impl<L: Lane> PacketSlab<L> {
+    /// The rays' directions.
+    #[inline(always)]
+    pub(crate) fn dir(&self) -> V3<L> {
+        self.dir
+    }
+
     fn new(rays: &RayPacket<L>, reach: f32) -> Self {
         let (o, d) = (rays.origin, rays.dir);
         let omax = lmax(lmax(o.x.abs(), o.y.abs()), o.z.abs());
@@ -451,6 +507,7 @@ impl<L: Lane> PacketSlab<L> {
             on,
             of,
             inv,
+            dir: d,
             all: !ok,
         }
     }
@@ -459,7 +516,7 @@ impl<L: Lane> PacketSlab<L> {
     /// parameters (`b`: the node's boxes, or with `REL` the per-eye rows, as
     /// [`Slab::test_rows`]).
     #[inline(always)]
-    fn test<const REL: bool>(
+    pub(crate) fn test<const REL: bool>(
         &self,
         b: &[[f32; WIDTH]; 6],
         k: usize,
@@ -489,8 +546,10 @@ impl<L: Lane> PacketSlab<L> {
 /// Pushes the children of node `c` (`n`) some lane of `active` enters, nearest (by the first
 /// such lane's entry) on top.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 fn visit<P: Leaf, V: View<P>, L: Lane>(
     view: &V,
+    x: &V::Many<L>,
     stack: &mut Stack,
     c: u32,
     n: &Node,
@@ -500,16 +559,11 @@ fn visit<P: Leaf, V: View<P>, L: Lane>(
 ) {
     let mut bits = 0u32;
     let mut key = [0.0f32; WIDTH];
-    let rows = view.rows(c, n);
     for (k, key) in key.iter_mut().enumerate() {
         if n.child[k] == EMPTY {
             continue;
         }
-        let (m, tn) = if V::REL {
-            slab.test::<true>(rows, k, r.t_min, r.t_max, active)
-        } else {
-            slab.test::<false>(rows, k, r.t_min, r.t_max, active)
-        };
+        let (m, tn) = view.node_many(x, slab, c, n, k, r.t_min, r.t_max, active);
         let mb = m.bits();
         if mb != 0 {
             bits |= 1 << k;
@@ -543,6 +597,7 @@ impl<P: Leaf> Bvh<'_, P> {
             return (best, win);
         }
         let slab = PacketSlab::new(rays, self.reach);
+        let x = view.many(rays);
         let pre = P::prepare(rays);
         let t_end = rays.t_max;
         let mut r = RayPacket {
@@ -553,7 +608,7 @@ impl<P: Leaf> Bvh<'_, P> {
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
-                    visit(view, &mut stack, c, n, &slab, &r, valid);
+                    visit(view, &x, &mut stack, c, n, &slab, &r, valid);
                 }
                 continue;
             }
@@ -607,13 +662,14 @@ impl<P: Leaf> Bvh<'_, P> {
             return hit;
         }
         let slab = PacketSlab::new(rays, self.reach);
+        let x = view.many(rays);
         let pre = P::prepare(rays);
         let mut stack = Stack::<STACK>::new();
         while let Some((c, _)) = stack.pop() {
             let active = valid.and_not(hit);
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
-                    visit(view, &mut stack, c, n, &slab, rays, active);
+                    visit(view, &x, &mut stack, c, n, &slab, rays, active);
                 }
                 continue;
             }
@@ -646,12 +702,13 @@ impl<P: Leaf> Bvh<'_, P> {
             return;
         }
         let slab = PacketSlab::new(rays, self.reach);
+        let x = view.many(rays);
         let pre = P::prepare(rays);
         let mut stack = Stack::<STACK>::new();
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
-                    visit(view, &mut stack, c, n, &slab, rays, valid);
+                    visit(view, &x, &mut stack, c, n, &slab, rays, valid);
                 }
                 continue;
             }

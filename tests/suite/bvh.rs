@@ -99,13 +99,14 @@ pub(crate) fn check(tree: &impl Query, flat: &impl Query, rays: &[Ray]) -> usize
 }
 
 /// Checks a triangle set against brute force on `rays`; returns the hit count.
-/// Also in focal mode: the tree focused on each of the first 300 rays' origins answers that
-/// ray as brute force does.
+/// Also in focal mode (both node caches): the tree focused on each of the first 300 rays'
+/// origins answers that ray as brute force does.
 fn check_tris(tris: &[Triangle], rays: &[Ray]) -> usize {
     let (nodes, leaves) = owned(tris);
     let tree = Bvh::from_parts(&nodes, &leaves).expect("a valid tree");
     let mut fnodes = vec![bvh::FocalNode::EMPTY; nodes.len()];
     let mut fleaves = vec![bvh::FocalLeaf::EMPTY; leaves.len()];
+    let mut snodes = vec![<bvh::SphereNode as bvh::NodeCache>::EMPTY; nodes.len()];
     for r in rays.iter().take(300) {
         let focal = tree.focus(r.origin(), &mut fnodes, &mut fleaves).unwrap();
         assert_eq!(
@@ -114,6 +115,15 @@ fn check_tris(tris: &[Triangle], rays: &[Ray]) -> usize {
             "focal: {r:?}"
         );
         assert_eq!(focal.any(r), tris.any(r), "focal any: {r:?}");
+        let spheres = tree
+            .focus_with(r.origin(), &mut snodes, &mut fleaves)
+            .unwrap();
+        assert_eq!(
+            bits(spheres.closest(r)),
+            bits(tris.closest(r)),
+            "spheres: {r:?}"
+        );
+        assert_eq!(spheres.any(r), tris.any(r), "spheres any: {r:?}");
     }
     check(&tree, &tris, rays)
 }

@@ -8,7 +8,7 @@ use crate::query::bits;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
-use raylane::bvh::{self, BuildError, Bvh, FocalLeaf, FocalNode, Leaf};
+use raylane::bvh::{self, BuildError, Bvh, FocalLeaf, FocalNode, Leaf, NodeCache, SphereNode};
 use raylane::mesh::Mesh;
 use raylane::sphere::{Robust, Sphere};
 use raylane::triangle::{Cull, Triangle};
@@ -58,9 +58,14 @@ fn focal_soups_equal_brute_force() {
                 let mut rs = from_eye(&mut rng, eye, 240, &aim);
                 let hits = check(&focal, &flat, &rs);
                 assert!(n < 40 || hits > 40, "{n} triangles: {hits} hits");
+                // The lecture's focal sphere node test: the same answers.
+                let mut snodes = vec![SphereNode::EMPTY; fnodes.len()];
+                let spheres = tree.focus_with(eye, &mut snodes, &mut fleaves).unwrap();
+                check(&spheres, &flat, &rs);
                 // Packets mixing rays from the eye and from elsewhere (world mode).
                 rs.extend(rays(&mut rng, 40, &aim));
                 rs.rotate_left(7);
+                let focal = tree.focus(eye, &mut fnodes, &mut fleaves).unwrap();
                 check(&focal, &flat, &rs);
             }
         }
@@ -117,6 +122,9 @@ fn focal_bunny_equals_brute_force_and_fills_lazily() {
             filled > 0 && filled < tree.leaves().len(),
             "{filled} leaves filled"
         );
+        let mut snodes = vec![SphereNode::EMPTY; fnodes.len()];
+        let spheres = tree.focus_with(eye, &mut snodes, &mut fleaves).unwrap();
+        check(&spheres, &&tris[..], &rs);
     }
 }
 
