@@ -312,10 +312,11 @@ fn peer_jobs<'a>(
 }
 
 /// raylane's BVH on every ray of one kind: single rays and packets of 8 and 16.
-fn bvh_jobs<'a, P: Leaf>(
+fn bvh_jobs<'a, P: Leaf + 'static>(
     shadow: bool,
     all: &'a [Ray],
     t: &'a Bvh<'a, P>,
+    eye: Option<Vec3>,
     keep: &'a Keep,
 ) -> Vec<Job<'a>> {
     let b8: &Vec<RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(all));
@@ -363,7 +364,48 @@ fn bvh_jobs<'a, P: Leaf>(
                 move || collect(|o| rl::bvh_closest(t, b16, n, o)),
             ),
         ]
+        .into_iter()
+        .chain(
+            eye.map(|e| focal_jobs(all, t, e, b8, b16, keep))
+                .into_iter()
+                .flatten(),
+        )
+        .collect()
     }
+}
+
+/// raylane's BVH in focal mode (primary rays from `eye`): the per-eye cache made inside
+/// every frame (`focus`, leaves filled lazily).
+fn focal_jobs<'a, P: Leaf + 'static>(
+    all: &'a [Ray],
+    t: &'a Bvh<'a, P>,
+    e: Vec3,
+    b8: &'a [RayPacket<f32x8>],
+    b16: &'a [RayPacket<f32x16>],
+    keep: &'a Keep,
+) -> Vec<Job<'a>> {
+    let st: &rl::FocalStore<P> = keep.put(rl::focal_store(t));
+    let (n, every) = (all.len(), (all.len(), true));
+    vec![
+        job(
+            "raylane BVH focal x1",
+            every,
+            move || rl::focal_closest1(t, e, st, all, None),
+            move || collect(|o| rl::focal_closest1(t, e, st, all, o)),
+        ),
+        job(
+            "raylane BVH focal x8",
+            every,
+            move || rl::focal_closest(t, e, st, b8, n, None),
+            move || collect(|o| rl::focal_closest(t, e, st, b8, n, o)),
+        ),
+        job(
+            "raylane BVH focal x16",
+            every,
+            move || rl::focal_closest(t, e, st, b16, n, None),
+            move || collect(|o| rl::focal_closest(t, e, st, b16, n, o)),
+        ),
+    ]
 }
 
 /// Keeps the converted rays of a scene alive while its jobs borrow them.
@@ -497,7 +539,8 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
                 move || collect(|o| rl::closest(s8, b, ids, ns, o)),
             ));
         }
-        jobs.extend(bvh_jobs(shadow, all, &tb, &keep));
+        let eye = (kind == Kind::Primary).then_some(w.cam.eye);
+        jobs.extend(bvh_jobs(shadow, all, &tb, eye, &keep));
         if kind == Kind::Primary {
             // The focal parts over every primary ray, the cache built for the eye inside
             // every frame.
@@ -613,7 +656,8 @@ fn sphere_scene(res: &mut Results, count: usize, opts: &Opts) {
             move || rl::spheres_closest(p16, sp, ns, None),
             move || occluded(collect(|o| rl::spheres_closest(p16, sp, ns, o))),
         ));
-        jobs.extend(bvh_jobs(shadow, all, &tb, &keep));
+        let eye = (kind == Kind::Primary).then_some(w.cam.eye);
+        jobs.extend(bvh_jobs(shadow, all, &tb, eye, &keep));
         run_jobs(res, &name, kind, (&want, STRIDE), jobs, runs);
     }
 }
@@ -771,6 +815,7 @@ fn report(res: &Results) {
         ("raylane brute force + spheres", "raylane brute force"),
         ("raylane focal + spheres", "raylane focal"),
         ("raylane BVH", "raylane BVH"),
+        ("raylane BVH focal", "raylane BVH focal"),
     ];
     let mut head = String::from("| scene | primitives |");
     let mut rule = String::from("| --- | ---: |");

@@ -17,7 +17,9 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use raylane::bvh::{self, Bvh, Leaf, Node, Primitives, Scratch, Sphere4, Tri4};
+use raylane::bvh::{
+    self, Bvh, FocalLeaf, FocalNode, Leaf, Node, Primitives, Scratch, Sphere4, Tri4,
+};
 use raylane::internals;
 use raylane::mesh::{FocalMesh, Mesh};
 use raylane::sphere::{Robust, Sphere};
@@ -206,9 +208,54 @@ impl Tree<Sphere4> {
     }
 }
 
+/// Per-eye storage for a [`raylane::bvh::FocalBvh`] of `t` (filled by `focus` inside each
+/// timed frame).
+pub type FocalStore<P> = std::cell::RefCell<(Vec<FocalNode>, Vec<FocalLeaf<P>>)>;
+
+/// Storage for [`FocalStore`] of `t`.
+pub fn focal_store<P: Leaf>(t: &Bvh<P>) -> FocalStore<P> {
+    let (n, l) = bvh::focal_needed(t);
+    std::cell::RefCell::new((vec![FocalNode::EMPTY; n], vec![FocalLeaf::EMPTY; l]))
+}
+
+/// Closest hits of single rays through `t` focused on `eye` (the focus inside the timing).
+#[inline(never)]
+pub fn focal_closest1<P: Leaf>(
+    t: &Bvh<P>,
+    eye: Vec3,
+    store: &FocalStore<P>,
+    rays: &[Ray],
+    out: Option<&mut Answers>,
+) -> u32 {
+    let mut s = store.borrow_mut();
+    let (nodes, leaves) = &mut *s;
+    let f = t
+        .focus(eye, nodes, leaves)
+        .expect("storage from focal_needed");
+    bvh_closest1(&f, rays, out)
+}
+
+/// Closest hits of ray packets through `t` focused on `eye` (the focus inside the timing).
+#[inline(never)]
+pub fn focal_closest<P: Leaf, L: Lane<Scalar = f32>>(
+    t: &Bvh<P>,
+    eye: Vec3,
+    store: &FocalStore<P>,
+    packets: &[RayPacket<L>],
+    rays: usize,
+    out: Option<&mut Answers>,
+) -> u32 {
+    let mut s = store.borrow_mut();
+    let (nodes, leaves) = &mut *s;
+    let f = t
+        .focus(eye, nodes, leaves)
+        .expect("storage from focal_needed");
+    bvh_closest(&f, packets, rays, out)
+}
+
 /// Closest hits of single rays through the BVH.
 #[inline(never)]
-pub fn bvh_closest1<P: Leaf>(t: &Bvh<P>, rays: &[Ray], mut out: Option<&mut Answers>) -> u32 {
+pub fn bvh_closest1(t: &impl Query, rays: &[Ray], mut out: Option<&mut Answers>) -> u32 {
     let mut n = 0;
     for r in rays {
         let h = t.closest(black_box(r));
@@ -223,8 +270,8 @@ pub fn bvh_closest1<P: Leaf>(t: &Bvh<P>, rays: &[Ray], mut out: Option<&mut Answ
 
 /// Closest hits of ray packets through the BVH.
 #[inline(never)]
-pub fn bvh_closest<P: Leaf, L: Lane<Scalar = f32>>(
-    t: &Bvh<P>,
+pub fn bvh_closest<L: Lane<Scalar = f32>>(
+    t: &impl Query,
     packets: &[RayPacket<L>],
     rays: usize,
     mut out: Option<&mut Answers>,
@@ -246,7 +293,7 @@ pub fn bvh_closest<P: Leaf, L: Lane<Scalar = f32>>(
 
 /// Any hit of single rays through the BVH.
 #[inline(never)]
-pub fn bvh_any1<P: Leaf>(t: &Bvh<P>, rays: &[Ray], mut out: Option<&mut Answers>) -> u32 {
+pub fn bvh_any1(t: &impl Query, rays: &[Ray], mut out: Option<&mut Answers>) -> u32 {
     let mut n = 0;
     for r in rays {
         let h = t.any(black_box(r));
@@ -260,8 +307,8 @@ pub fn bvh_any1<P: Leaf>(t: &Bvh<P>, rays: &[Ray], mut out: Option<&mut Answers>
 
 /// Any hit of ray packets through the BVH.
 #[inline(never)]
-pub fn bvh_any<P: Leaf, L: Lane<Scalar = f32>>(
-    t: &Bvh<P>,
+pub fn bvh_any<L: Lane<Scalar = f32>>(
+    t: &impl Query,
     packets: &[RayPacket<L>],
     rays: usize,
     mut out: Option<&mut Answers>,

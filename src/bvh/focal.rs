@@ -101,9 +101,9 @@ impl NodeCache for FocalNode {
     const EMPTY: Self = FocalNode::EMPTY;
     fn make(n: &Node, e: [f32; 3], m: f32) -> Self {
         let mut f = FocalNode::EMPTY;
-        for a in 0..3 {
-            f.rows[a] = n.bounds[a].map(|b| (b - e[a]) - m);
-            f.rows[3 + a] = n.bounds[3 + a].map(|b| (b - e[a]) + m);
+        for (a, &ea) in e.iter().enumerate() {
+            f.rows[a] = n.bounds[a].map(|b| (b - ea) - m);
+            f.rows[3 + a] = n.bounds[3 + a].map(|b| (b - ea) + m);
         }
         f
     }
@@ -146,9 +146,9 @@ impl NodeCache for SphereNode {
             let r =
                 (libm::sqrt(h2) + f64::from(m)) * (1.0 + 1.0 / 65536.0) + libm::sqrt(cc) / 1024.0;
             let kk = cc - r * r;
-            let empty = n.child[k] == EMPTY || !(lo[0] <= hi[0]);
-            for a in 0..3 {
-                s.rows[a][k] = if empty { 0.0 } else { c[a] as f32 };
+            let empty = n.child[k] == EMPTY || lo[0].partial_cmp(&hi[0]).is_none_or(|o| o.is_gt());
+            for (row, &ca) in s.rows.iter_mut().zip(&c) {
+                row[k] = if empty { 0.0 } else { ca as f32 };
             }
             s.rows[3][k] = if empty { 0.0 } else { r as f32 };
             s.rows[4][k] = if empty { f32::INFINITY } else { kk as f32 };
@@ -335,7 +335,7 @@ impl<'s, P: Leaf, N: NodeCache> FocalBvh<'s, '_, P, N> {
     }
 
     /// True when every valid lane of `rays` starts at the eye, bit for bit.
-    fn from_eye<L: Lane>(&self, rays: &RayPacket<L>) -> bool {
+    fn at_eye<L: Lane>(&self, rays: &RayPacket<L>) -> bool {
         if !self.on {
             return false;
         }
@@ -465,7 +465,7 @@ impl<P: Leaf, N: NodeCache> View<P> for FocalBvh<'_, '_, P, N> {
 /// cache.
 impl<P: Leaf, N: NodeCache> Query for FocalBvh<'_, '_, P, N> {
     fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
-        if self.from_eye(rays) {
+        if self.at_eye(rays) {
             closest_packet(&self.bvh, self, rays)
         } else {
             closest_packet(&self.bvh, &World, rays)
@@ -473,7 +473,7 @@ impl<P: Leaf, N: NodeCache> Query for FocalBvh<'_, '_, P, N> {
     }
 
     fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
-        if self.from_eye(rays) {
+        if self.at_eye(rays) {
             self.bvh.any_lanes(self, rays)
         } else {
             self.bvh.any_lanes(&World, rays)
@@ -481,7 +481,7 @@ impl<P: Leaf, N: NodeCache> Query for FocalBvh<'_, '_, P, N> {
     }
 
     fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
-        if self.from_eye(rays) {
+        if self.at_eye(rays) {
             self.bvh.all_lanes(self, rays, f)
         } else {
             self.bvh.all_lanes(&World, rays, f)
