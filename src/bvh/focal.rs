@@ -43,7 +43,7 @@ use glam::Vec3;
 use wide::{f32x4, f32x8};
 
 use super::query::{closest_packet, closest_ray};
-use super::traverse::{LeafTest, MARGIN, PacketSlab, Slab, View, World, lmax, lmin};
+use super::traverse::{Frustum, LeafTest, MARGIN, PacketSlab, Slab, View, World, lmax, lmin};
 use super::{BuildError, Bvh, EMPTY, Leaf, Node, WIDTH};
 use crate::hit::LaneHit;
 use crate::lane::{Lane, Mask, Scalar};
@@ -436,6 +436,21 @@ impl<P: Leaf, N: NodeCache> View<P> for FocalBvh<'_, '_, P, N> {
                 ((m | slab.all) & active, tn)
             }
             None => slab.test::<false>(&n.bounds, k, t_min, t_max, active),
+        }
+    }
+    /// A node index beyond the cache, and [`SphereNode`]s, are tested child by child.
+    #[inline(always)]
+    fn node_frustum(
+        &self,
+        f: &Frustum,
+        c: u32,
+        _: &Node,
+        t_lo: f32,
+        t_hi: f32,
+    ) -> Option<(u32, f32x8)> {
+        match self.nodes.get(c as usize).map(N::rows) {
+            Some(NodeRows::Boxes(r)) => Some(f.test::<true>(r, t_lo, t_hi)),
+            _ => None,
         }
     }
     type Test<'a>

@@ -49,6 +49,17 @@ pub(crate) trait View<P: Leaf> {
         t_max: L,
         active: L::Mask,
     ) -> (L::Mask, L);
+    /// A packet's [`Frustum`] against the children of node `c` (`n`): a superset of the
+    /// children some lane enters, and lower bounds of the lanes' entry parameters (`None`:
+    /// test child by child).
+    fn node_frustum(
+        &self,
+        f: &Frustum,
+        c: u32,
+        n: &Node,
+        t_lo: f32,
+        t_hi: f32,
+    ) -> Option<(u32, f32x8)>;
     /// What the kernels test for a leaf.
     type Test<'a>: LeafTest<P>
     where
@@ -122,6 +133,17 @@ impl<P: Leaf> View<P> for World {
         active: L::Mask,
     ) -> (L::Mask, L) {
         slab.test::<false>(&n.bounds, k, t_min, t_max, active)
+    }
+    #[inline(always)]
+    fn node_frustum(
+        &self,
+        f: &Frustum,
+        _: u32,
+        n: &Node,
+        t_lo: f32,
+        t_hi: f32,
+    ) -> Option<(u32, f32x8)> {
+        Some(f.test::<false>(&n.bounds, t_lo, t_hi))
     }
     type Test<'a>
         = &'a P
@@ -543,8 +565,129 @@ impl<L: Lane> PacketSlab<L> {
     }
 }
 
+/// A packet's slab constants as intervals over its valid lanes, for packets whose directions
+/// share their sign on every axis (and whose lanes all pass the slab test's range checks):
+/// one `f32x8` interval test per node tests all 8 children for the whole packet.
+///
+/// Each lane's entry on an axis is `fl(fl(p − o_i)·v_i)`, with the near plane `p` the same
+/// for every lane (the signs agree). Rounding is monotonic, so `fl(p − o_i)` lies between
+/// `fl(p − max o)` and `fl(p − min o)`, and `fl(x·v_i)` between the rounded products of the
+/// interval's corners: with `v > 0` the lowest entry is `min(x_lo·v_min, x_lo·v_max)`, with
+/// `v < 0` `min(x_hi·v_min, x_hi·v_max)`, and the exits likewise from above. So a child some
+/// lane's own slab test enters passes the interval test (never the converse: a pass only
+/// means "look closer"), and every answer stays the per-lane traversal's.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Frustum {
+    near: [usize; 3],
+    far: [usize; 3],
+    /// Per axis: the near origins' (min, max), the far origins' (min, max), the inverse
+    /// directions' (min, max), and whether they are negative.
+    on: [(f32, f32); 3],
+    of: [(f32, f32); 3],
+    inv: [(f32, f32); 3],
+    neg: [bool; 3],
+}
+
+impl Frustum {
+    /// The intervals of the `valid` lanes of `s`, or `None` when their directions' signs
+    /// differ on some axis or a lane visits every child.
+    pub(crate) fn new<L: Lane>(s: &PacketSlab<L>, valid: L::Mask) -> Option<Frustum> {
+        if (s.all & valid).any() || valid.none() {
+            return None;
+        }
+        let mut f = Frustum {
+            near: [0, 1, 2],
+            far: [3, 4, 5],
+            on: [(0.0, 0.0); 3],
+            of: [(0.0, 0.0); 3],
+            inv: [(0.0, 0.0); 3],
+            neg: [false; 3],
+        };
+        let range = |x: L| {
+            let mut r = (f32::INFINITY, f32::NEG_INFINITY);
+            let mut bits = valid.bits();
+            while bits != 0 {
+                let v = lane_f32(x, bits.trailing_zeros() as usize);
+                bits &= bits - 1;
+                r = (r.0.min(v), r.1.max(v));
+            }
+            r
+        };
+        for a in 0..3 {
+            let neg = s.neg[a] & valid;
+            if neg.any() && valid.and_not(neg).any() {
+                return None;
+            }
+            f.neg[a] = neg.any();
+            if f.neg[a] {
+                f.near[a] = 3 + a;
+                f.far[a] = a;
+            }
+            f.on[a] = range(s.on[a]);
+            f.of[a] = range(s.of[a]);
+            f.inv[a] = range(s.inv[a]);
+        }
+        Some(f)
+    }
+
+    /// Bit `k` set when some lane may enter child `k` of the rows `b` (the node's boxes, or
+    /// with `REL` the per-eye rows: no subtraction) within `(t_lo, t_hi)` (the lanes' lowest
+    /// `t_min` and highest `t_max`); lower bounds of the lanes' entry parameters.
+    #[inline(always)]
+    pub(crate) fn test<const REL: bool>(
+        &self,
+        b: &[[f32; WIDTH]; 6],
+        t_lo: f32,
+        t_hi: f32,
+    ) -> (u32, f32x8) {
+        let mut tn = f32x8::splat(t_lo);
+        let mut tf = f32x8::splat(t_hi);
+        for a in 0..3 {
+            let (near, far) = (f32x8::new(b[self.near[a]]), f32x8::new(b[self.far[a]]));
+            let (vl, vh) = self.inv[a];
+            // The near planes' lowest and the far planes' highest offsets that matter.
+            let (x, y) = if REL {
+                (near, far)
+            } else if self.neg[a] {
+                (near - self.on[a].0, far - self.of[a].1)
+            } else {
+                (near - self.on[a].1, far - self.of[a].0)
+            };
+            tn = tn.fast_max((x * vl).fast_min(x * vh));
+            tf = tf.fast_min((y * vl).fast_max(y * vh));
+        }
+        (tn.simd_le(tf).to_bitmask(), tn)
+    }
+}
+
+/// The highest `t_max` of the `valid` lanes.
+#[inline(always)]
+fn highest<L: Lane>(t: L, valid: L::Mask) -> f32 {
+    let mut r = f32::NEG_INFINITY;
+    let mut bits = valid.bits();
+    while bits != 0 {
+        r = r.max(lane_f32(t, bits.trailing_zeros() as usize));
+        bits &= bits - 1;
+    }
+    r
+}
+
+/// A packet's [`Frustum`] with its lanes' lowest `t_min` and highest `t_max`.
+#[inline(always)]
+fn frustum<L: Lane>(
+    slab: &PacketSlab<L>,
+    rays: &RayPacket<L>,
+    valid: L::Mask,
+) -> Option<(Frustum, f32, f32)> {
+    let f = Frustum::new(slab, valid)?;
+    let lo = -highest(-rays.t_min, valid);
+    Some((f, lo, highest(rays.t_max, valid)))
+}
+
 /// Pushes the children of node `c` (`n`) some lane of `active` enters, nearest (by the first
-/// such lane's entry) on top.
+/// such lane's entry) on top. With a [`Frustum`], the children are tested for the whole
+/// packet at once (`t_lo`, `t_hi`: the lanes' lowest `t_min` and highest `t_max`), and a leaf
+/// child only if some lane's own slab test enters it.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn visit<P: Leaf, V: View<P>, L: Lane>(
@@ -556,7 +699,25 @@ fn visit<P: Leaf, V: View<P>, L: Lane>(
     slab: &PacketSlab<L>,
     r: &RayPacket<L>,
     active: L::Mask,
+    fr: Option<&(Frustum, f32, f32)>,
 ) {
+    if let Some((f, t_lo, t_hi)) = fr
+        && let Some((mut bits, tn)) = view.node_frustum(f, c, n, *t_lo, *t_hi)
+    {
+        let mut leaves = bits;
+        while leaves != 0 {
+            let k = leaves.trailing_zeros() as usize;
+            leaves &= leaves - 1;
+            if n.child[k] & LEAF != 0 {
+                let (m, _) = view.node_many(x, slab, c, n, k, r.t_min, r.t_max, active);
+                if m.none() {
+                    bits &= !(1 << k);
+                }
+            }
+        }
+        stack.push_sorted(n, bits, &tn.to_array());
+        return;
+    }
     let mut bits = 0u32;
     let mut key = [0.0f32; WIDTH];
     for (k, key) in key.iter_mut().enumerate() {
@@ -604,11 +765,12 @@ impl<P: Leaf> Bvh<'_, P> {
             t_max: L::select(valid, relax(rays.t_max), rays.t_max),
             ..*rays
         };
+        let mut fr = frustum(&slab, &r, valid);
         let mut stack = Stack::<STACK>::new();
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
-                    visit(view, &x, &mut stack, c, n, &slab, &r, valid);
+                    visit(view, &x, &mut stack, c, n, &slab, &r, valid, fr.as_ref());
                 }
                 continue;
             }
@@ -640,6 +802,9 @@ impl<P: Leaf> Bvh<'_, P> {
                 if take.any() {
                     best.take(&h, take, index);
                     r = r.shrink(take, relax(h.t));
+                    if let Some(f) = fr.as_mut() {
+                        f.2 = highest(r.t_max, valid);
+                    }
                     let mut bits = take.bits();
                     while bits != 0 {
                         let j = bits.trailing_zeros() as usize;
@@ -664,12 +829,13 @@ impl<P: Leaf> Bvh<'_, P> {
         let slab = PacketSlab::new(rays, self.reach);
         let x = view.many(rays);
         let pre = P::prepare(rays);
+        let fr = frustum(&slab, rays, valid);
         let mut stack = Stack::<STACK>::new();
         while let Some((c, _)) = stack.pop() {
             let active = valid.and_not(hit);
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
-                    visit(view, &x, &mut stack, c, n, &slab, rays, active);
+                    visit(view, &x, &mut stack, c, n, &slab, rays, active, fr.as_ref());
                 }
                 continue;
             }
@@ -704,11 +870,12 @@ impl<P: Leaf> Bvh<'_, P> {
         let slab = PacketSlab::new(rays, self.reach);
         let x = view.many(rays);
         let pre = P::prepare(rays);
+        let fr = frustum(&slab, rays, valid);
         let mut stack = Stack::<STACK>::new();
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
-                    visit(view, &x, &mut stack, c, n, &slab, rays, valid);
+                    visit(view, &x, &mut stack, c, n, &slab, rays, valid, fr.as_ref());
                 }
                 continue;
             }

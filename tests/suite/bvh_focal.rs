@@ -198,3 +198,51 @@ fn focal_storage_and_bad_eyes() {
     let focal = tree.focus(Vec3::Z, &mut fnodes, &mut fleaves).unwrap();
     assert_eq!(focal.closest(&Ray::new(Vec3::Z, -Vec3::Z)), None);
 }
+
+/// Coherent packets (camera rows, and parallel rays from a grid of origins), where packets
+/// take the interval ("frustum") node test: every lane equals brute force, in world and focal
+/// mode, at every width.
+#[test]
+fn coherent_packets_equal_brute_force() {
+    let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
+    let mesh = Mesh::new(&m.pos, &m.idx);
+    let (nodes, leaves) = owned(&mesh);
+    let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
+    let tris = flat(&mesh);
+    let (lo, hi) = m.pos.iter().fold(
+        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+        |(l, h), &p| (l.min(p), h.max(p)),
+    );
+    let (c, r) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+    let (mut fnodes, mut fleaves) = storage(&tree);
+    let mut rng = SmallRng::seed_from_u64(145);
+    for k in 0..4 {
+        let eye = c + v3(&mut rng, 1.0).normalize_or(Vec3::X) * r * (1.3 + k as f32);
+        let cam = raylane::Pinhole::look_at(eye, c, Vec3::Y, 40.0, 64, 48);
+        let rs: Vec<Ray> = (0..cam.height)
+            .flat_map(|y| (0..cam.width).map(move |x| (x, y)))
+            .map(|(x, y)| cam.row_packet::<f32>(x, y).ray(0))
+            .collect();
+        let hits = check(&tree, &&tris[..], &rs);
+        assert!(hits > 100, "eye {k}: {hits} hits");
+        let focal = tree.focus(eye, &mut fnodes, &mut fleaves).unwrap();
+        check(&focal, &&tris[..], &rs);
+        // Parallel rays from a grid of origins (origin intervals), some with finite ends.
+        let d = (c - eye).normalize();
+        let (u, v) = (
+            d.any_orthonormal_pair().0 * r / 20.0,
+            d.any_orthonormal_pair().1 * r / 20.0,
+        );
+        let rs: Vec<Ray> = (0..48 * 48)
+            .map(|i| {
+                let o = eye + u * ((i % 48) as f32 - 24.0) + v * ((i / 48) as f32 - 24.0);
+                if i % 7 == 0 {
+                    Ray::with_interval(o, d, 0.5 * r, 2.0 * r + k as f32 * r)
+                } else {
+                    Ray::new(o, d)
+                }
+            })
+            .collect();
+        assert!(check(&tree, &&tris[..], &rs) > 200);
+    }
+}
