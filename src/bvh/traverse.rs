@@ -11,8 +11,9 @@ use crate::lane::{Lane, Mask};
 use crate::query::Hits;
 use crate::ray::{Ray, RayPacket};
 
-/// The box widening relative to `R + |o|∞`: `2^-14`.
-const MARGIN: f32 = 1.0 / 16384.0;
+/// The box widening relative to `R + |o|∞`: `2^-17` (see the [module docs](super) for why it
+/// is conservative).
+const MARGIN: f32 = 1.0 / 131072.0;
 /// The largest `R + |o|∞` the slab test handles (`2^100`); beyond it every child is visited.
 const FAR: f32 = 1.2676506e30;
 /// Inverse direction components are clamped to `±2^100` (a zero component gives `±2^100`).
