@@ -56,15 +56,13 @@ impl Slab {
             let da = d[a] + 0.0;
             let neg = da < 0.0;
             s.inv[a] = (1.0 / da).clamp(-INV_MAX, INV_MAX);
-            if neg {
-                s.near[a] = 3 + a;
-                s.far[a] = a;
-                s.on[a] = o[a] - m;
-                s.of[a] = o[a] + m;
-            } else {
-                s.on[a] = o[a] + m;
-                s.of[a] = o[a] - m;
-            }
+            // Selects rather than branches: the sign of an incoherent ray's direction is
+            // unpredictable.
+            let (lo, hi) = (o[a] - m, o[a] + m);
+            s.near[a] = if neg { 3 + a } else { a };
+            s.far[a] = if neg { a } else { 3 + a };
+            s.on[a] = if neg { lo } else { hi };
+            s.of[a] = if neg { hi } else { lo };
         }
         s
     }
@@ -115,16 +113,23 @@ pub(crate) struct Stack<const N: usize = STACK> {
 impl<const N: usize> Stack<N> {
     #[inline(always)]
     pub(crate) fn new() -> Self {
-        let mut s = Stack {
-            node: [0; N],
-            tn: [0.0; N],
-            len: 1,
-            overflow: false,
-        };
+        let mut s = Self::empty();
+        s.len = 1;
         if let Some(t) = s.tn.first_mut() {
             *t = f32::NEG_INFINITY;
         }
         s
+    }
+
+    /// A stack without the root (the one-ray queries test the root first).
+    #[inline(always)]
+    pub(crate) fn empty() -> Self {
+        Stack {
+            node: [0; N],
+            tn: [0.0; N],
+            len: 0,
+            overflow: false,
+        }
     }
 
     #[inline(always)]
@@ -197,7 +202,9 @@ impl<P: Leaf> Bvh<'_, P> {
         }
         let slab = Slab::new(ray.origin(), ray.dir(), self.reach);
         let r4 = RayPacket::<f32x4>::splat(ray);
-        let pre = P::prepare(&r4);
+        // The leaf kernel's per-ray set-up (Watertight: the shear, 3 divisions), made at the
+        // first leaf: most rays that leave a surface reach none.
+        let mut pre = None;
         let t_end = ray.t_max();
         let mut t_max = relax(t_end);
         let mut best = One {
@@ -209,7 +216,17 @@ impl<P: Leaf> Bvh<'_, P> {
             leaf: 0,
             lane: 0,
         };
-        let mut stack = Stack::<N>::new();
+        // The root is tested before the stack is set up: a ray that meets none of its
+        // children (most rays leaving a convex part) costs one slab test.
+        let Some(root) = self.nodes.first() else {
+            return Ok(None);
+        };
+        let (bits, tn) = slab.test(root, ray.t_min(), t_max);
+        if bits == 0 {
+            return Ok(None);
+        }
+        let mut stack = Stack::<N>::empty();
+        stack.push_sorted(root, bits, &tn.to_array());
         while let Some((c, tn)) = stack.pop() {
             if tn > t_max {
                 continue;
@@ -230,7 +247,8 @@ impl<P: Leaf> Bvh<'_, P> {
                 t_max: f32x4::splat(t_max),
                 ..r4
             };
-            let h = leaf.test_four(&r, &pre, self.cull);
+            let pre = pre.get_or_insert_with(|| P::prepare(&r4));
+            let h = leaf.test_four(&r, pre, self.cull);
             let mut bits = h.mask.bits();
             while bits != 0 {
                 let j = bits.trailing_zeros() as usize;
@@ -280,8 +298,17 @@ impl<P: Leaf> Bvh<'_, P> {
         }
         let slab = Slab::new(ray.origin(), ray.dir(), self.reach);
         let r4 = RayPacket::<f32x4>::splat(ray);
-        let pre = P::prepare(&r4);
-        let mut stack = Stack::<N>::new();
+        // Made at the first leaf, as in `closest_with`.
+        let mut pre = None;
+        let Some(root) = self.nodes.first() else {
+            return Some(false);
+        };
+        let (bits, tn) = slab.test(root, ray.t_min(), ray.t_max());
+        if bits == 0 {
+            return Some(false);
+        }
+        let mut stack = Stack::<N>::empty();
+        stack.push_sorted(root, bits, &tn.to_array());
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 let Some(n) = self.nodes.get(c as usize) else {
@@ -290,7 +317,10 @@ impl<P: Leaf> Bvh<'_, P> {
                 let (bits, tn) = slab.test(n, ray.t_min(), ray.t_max());
                 stack.push_sorted(n, bits, &tn.to_array());
             } else if let Some(leaf) = self.leaves.get((c & !LEAF) as usize)
-                && leaf.test_four(&r4, &pre, self.cull).mask.any()
+                && leaf
+                    .test_four(&r4, pre.get_or_insert_with(|| P::prepare(&r4)), self.cull)
+                    .mask
+                    .any()
             {
                 return Some(true);
             }
