@@ -36,6 +36,7 @@ pub(crate) struct Slab {
 }
 
 impl Slab {
+    #[inline(always)]
     pub(crate) fn new(o: Vec3, d: Vec3, reach: f32) -> Self {
         let (o, d) = (o.to_array(), d.to_array());
         let omax = o[0].abs().max(o[1].abs()).max(o[2].abs());
