@@ -57,13 +57,15 @@ impl Slab {
             let da = d[a] + 0.0;
             let neg = da < 0.0;
             s.inv[a] = (1.0 / da).clamp(-INV_MAX, INV_MAX);
-            // Selects rather than branches: the sign of an incoherent ray's direction is
-            // unpredictable.
-            let (lo, hi) = (o[a] - m, o[a] + m);
-            s.near[a] = if neg { 3 + a } else { a };
-            s.far[a] = if neg { a } else { 3 + a };
-            s.on[a] = if neg { lo } else { hi };
-            s.of[a] = if neg { hi } else { lo };
+            // Arithmetic rather than branches or selects (which the compiler may turn into
+            // branches): the sign of an incoherent ray's direction is unpredictable. `ms` is
+            // `±m` (a sign flip, exact), so `o + ms` and `o − ms` are `o ± m` bit for bit.
+            let k = neg as usize;
+            let ms = f32::from_bits(m.to_bits() ^ ((neg as u32) << 31));
+            s.near[a] = a + 3 * k;
+            s.far[a] = 3 + a - 3 * k;
+            s.on[a] = o[a] + ms;
+            s.of[a] = o[a] - ms;
         }
         s
     }
