@@ -23,7 +23,7 @@
 //! world traversal's (the relative vertices are the kernel's own first step), and the
 //! cached planes are conservative as the world's are: `fl(fl(b − E) ∓ m)` differs from the
 //! widened plane by two roundings of at most `2^-24·(R + |E|∞)`, far inside the margin
-//! `m = 2^-14·(R + |E|∞)` (see the [module docs](super)). So every query equals brute force
+//! `m = 2^-17·(R + |E|∞)` (see the [module docs](super)). So every query equals brute force
 //! with the same kernel, bit for bit.
 //!
 //! **Rays from elsewhere.** A ray (or a packet with a valid lane) whose origin is not the

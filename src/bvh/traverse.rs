@@ -155,8 +155,9 @@ impl<P: Leaf> View<P> for World {
     }
 }
 
-/// The box widening relative to `R + |o|∞`: `2^-14`.
-pub(crate) const MARGIN: f32 = 1.0 / 16384.0;
+/// The box widening relative to `R + |o|∞`: `2^-17` (see the [module docs](super) for why it
+/// is conservative).
+pub(crate) const MARGIN: f32 = 1.0 / 131072.0;
 /// The largest `R + |o|∞` the slab test handles (`2^100`); beyond it every child is visited.
 const FAR: f32 = 1.2676506e30;
 /// Inverse direction components are clamped to `±2^100` (a zero component gives `±2^100`).
@@ -186,6 +187,7 @@ impl Slab {
         self.dir
     }
 
+    #[inline(always)]
     pub(crate) fn new(o: Vec3, d: Vec3, reach: f32) -> Self {
         let (o, d) = (o.to_array(), d.to_array());
         let omax = o[0].abs().max(o[1].abs()).max(o[2].abs());
@@ -207,15 +209,15 @@ impl Slab {
             let da = d[a] + 0.0;
             let neg = da < 0.0;
             s.inv[a] = (1.0 / da).clamp(-INV_MAX, INV_MAX);
-            if neg {
-                s.near[a] = 3 + a;
-                s.far[a] = a;
-                s.on[a] = o[a] - m;
-                s.of[a] = o[a] + m;
-            } else {
-                s.on[a] = o[a] + m;
-                s.of[a] = o[a] - m;
-            }
+            // Arithmetic rather than branches or selects (which the compiler may turn into
+            // branches): the sign of an incoherent ray's direction is unpredictable. `ms` is
+            // `±m` (a sign flip, exact), so `o + ms` and `o − ms` are `o ± m` bit for bit.
+            let k = neg as usize;
+            let ms = f32::from_bits(m.to_bits() ^ ((neg as u32) << 31));
+            s.near[a] = a + 3 * k;
+            s.far[a] = 3 + a - 3 * k;
+            s.on[a] = o[a] + ms;
+            s.of[a] = o[a] - ms;
         }
         s
     }
@@ -285,16 +287,23 @@ pub(crate) struct Stack<const N: usize = STACK> {
 impl<const N: usize> Stack<N> {
     #[inline(always)]
     pub(crate) fn new() -> Self {
-        let mut s = Stack {
-            node: [0; N],
-            tn: [0.0; N],
-            len: 1,
-            overflow: false,
-        };
+        let mut s = Self::empty();
+        s.len = 1;
         if let Some(t) = s.tn.first_mut() {
             *t = f32::NEG_INFINITY;
         }
         s
+    }
+
+    /// A stack without the root (the one-ray queries test the root first).
+    #[inline(always)]
+    pub(crate) fn empty() -> Self {
+        Stack {
+            node: [0; N],
+            tn: [0.0; N],
+            len: 0,
+            overflow: false,
+        }
     }
 
     #[inline(always)]
@@ -372,7 +381,9 @@ impl<P: Leaf> Bvh<'_, P> {
         let slab = Slab::new(ray.origin(), ray.dir(), self.reach);
         let x = view.one(ray);
         let r4 = RayPacket::<f32x4>::splat(ray);
-        let pre = P::prepare(&r4);
+        // The leaf kernel's per-ray set-up (Watertight: the shear, 3 divisions), made at the
+        // first leaf: most rays that leave a surface reach none.
+        let mut pre = None;
         let t_end = ray.t_max();
         let mut t_max = relax(t_end);
         let mut best = One {
@@ -384,7 +395,17 @@ impl<P: Leaf> Bvh<'_, P> {
             leaf: 0,
             lane: 0,
         };
-        let mut stack = Stack::<N>::new();
+        // The root is tested before the stack is set up: a ray that meets none of its
+        // children (most rays leaving a convex part) costs one slab test.
+        let Some(root) = self.nodes.first() else {
+            return Ok(None);
+        };
+        let (bits, tn) = view.node_one(&x, &slab, 0, root, ray.t_min(), t_max);
+        if bits == 0 {
+            return Ok(None);
+        }
+        let mut stack = Stack::<N>::empty();
+        stack.push_sorted(root, bits, &tn.to_array());
         while let Some((c, tn)) = stack.pop() {
             if tn > t_max {
                 continue;
@@ -405,7 +426,8 @@ impl<P: Leaf> Bvh<'_, P> {
                 t_max: f32x4::splat(t_max),
                 ..r4
             };
-            let h = view.leaf(li, leaf).four(&r, &pre, self.cull);
+            let pre = pre.get_or_insert_with(|| P::prepare(&r4));
+            let h = view.leaf(li, leaf).four(&r, pre, self.cull);
             let mut bits = h.mask.bits();
             while bits != 0 {
                 let j = bits.trailing_zeros() as usize;
@@ -456,8 +478,17 @@ impl<P: Leaf> Bvh<'_, P> {
         let slab = Slab::new(ray.origin(), ray.dir(), self.reach);
         let x = view.one(ray);
         let r4 = RayPacket::<f32x4>::splat(ray);
-        let pre = P::prepare(&r4);
-        let mut stack = Stack::<N>::new();
+        // Made at the first leaf, as in `closest_with`.
+        let mut pre = None;
+        let Some(root) = self.nodes.first() else {
+            return Some(false);
+        };
+        let (bits, tn) = view.node_one(&x, &slab, 0, root, ray.t_min(), ray.t_max());
+        if bits == 0 {
+            return Some(false);
+        }
+        let mut stack = Stack::<N>::empty();
+        stack.push_sorted(root, bits, &tn.to_array());
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 let Some(n) = self.nodes.get(c as usize) else {
@@ -468,7 +499,7 @@ impl<P: Leaf> Bvh<'_, P> {
             } else if let Some(leaf) = self.leaves.get((c & !LEAF) as usize)
                 && view
                     .leaf(c & !LEAF, leaf)
-                    .four(&r4, &pre, self.cull)
+                    .four(&r4, pre.get_or_insert_with(|| P::prepare(&r4)), self.cull)
                     .mask
                     .any()
             {
@@ -690,10 +721,10 @@ fn frustum<L: Lane>(
 /// child only if some lane's own slab test enters it.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
-fn visit<P: Leaf, V: View<P>, L: Lane>(
+fn visit<P: Leaf, V: View<P>, L: Lane, const N: usize>(
     view: &V,
     x: &V::Many<L>,
-    stack: &mut Stack,
+    stack: &mut Stack<N>,
     c: u32,
     n: &Node,
     slab: &PacketSlab<L>,
@@ -750,12 +781,30 @@ impl<P: Leaf> Bvh<'_, P> {
         view: &V,
         rays: &RayPacket<L>,
     ) -> (Best<L>, [u32; MAX_LANES]) {
+        // A short stack first (initialising 2 KB per packet is a tenth of a shadow packet's
+        // work); a packet that would overflow it runs again with the full one.
+        match self.closest_lanes_with::<SHORT, V, L>(view, rays) {
+            Some(r) => r,
+            None => self
+                .closest_lanes_with::<STACK, V, L>(view, rays)
+                .unwrap_or((Best::<L>::miss(), [0; MAX_LANES])),
+        }
+    }
+
+    /// [`closest_lanes`](Self::closest_lanes) with a stack of `N` entries: `None` when it
+    /// overflowed (never with `N = STACK`).
+    #[inline(always)]
+    fn closest_lanes_with<const N: usize, V: View<P>, L: Lane>(
+        &self,
+        view: &V,
+        rays: &RayPacket<L>,
+    ) -> Option<(Best<L>, [u32; MAX_LANES])> {
         crate::lane::assert_fits::<L>();
         let valid = rays.valid();
         let mut best = Best::<L>::miss();
         let mut win = [0u32; MAX_LANES];
         if valid.none() {
-            return (best, win);
+            return Some((best, win));
         }
         let slab = PacketSlab::new(rays, self.reach);
         let x = view.many(rays);
@@ -766,7 +815,7 @@ impl<P: Leaf> Bvh<'_, P> {
             ..*rays
         };
         let mut fr = frustum(&slab, &r, valid);
-        let mut stack = Stack::<STACK>::new();
+        let mut stack = Stack::<N>::new();
         while let Some((c, _)) = stack.pop() {
             if c & LEAF == 0 {
                 if let Some(n) = self.nodes.get(c as usize) {
@@ -816,21 +865,37 @@ impl<P: Leaf> Bvh<'_, P> {
                 }
             }
         }
-        (best.finish(), win)
+        (!stack.overflow).then(|| (best.finish(), win))
     }
 
     /// Lanes whose ray hits some primitive (occlusion); stops when every valid lane has hit.
     pub(crate) fn any_lanes<V: View<P>, L: Lane>(&self, view: &V, rays: &RayPacket<L>) -> L::Mask {
+        match self.any_lanes_with::<SHORT, V, L>(view, rays) {
+            Some(m) => m,
+            None => self
+                .any_lanes_with::<STACK, V, L>(view, rays)
+                .unwrap_or(L::Mask::splat(false)),
+        }
+    }
+
+    /// [`any_lanes`](Self::any_lanes) with a stack of `N` entries: `None` when it overflowed
+    /// before every valid lane had hit.
+    #[inline(always)]
+    fn any_lanes_with<const N: usize, V: View<P>, L: Lane>(
+        &self,
+        view: &V,
+        rays: &RayPacket<L>,
+    ) -> Option<L::Mask> {
         let valid = rays.valid();
         let mut hit = L::Mask::splat(false);
         if valid.none() {
-            return hit;
+            return Some(hit);
         }
         let slab = PacketSlab::new(rays, self.reach);
         let x = view.many(rays);
         let pre = P::prepare(rays);
         let fr = frustum(&slab, rays, valid);
-        let mut stack = Stack::<STACK>::new();
+        let mut stack = Stack::<N>::new();
         while let Some((c, _)) = stack.pop() {
             let active = valid.and_not(hit);
             if c & LEAF == 0 {
@@ -849,10 +914,10 @@ impl<P: Leaf> Bvh<'_, P> {
                 }
             }
             if valid.and_not(hit).none() {
-                break;
+                return Some(hit);
             }
         }
-        hit
+        (!stack.overflow).then_some(hit)
     }
 
     /// Every hit, as the flat set's `all` reports each primitive's, in traversal order (leaves
