@@ -46,9 +46,14 @@
 //! A [`Bvh`] implements [`Query`](crate::Query): `closest`, `any`, `all` for one [`Ray`](crate::Ray)
 //! (children in lanes: one `f32x8` slab test per node, nearest child first; leaves with one
 //! `f32x4` kernel call: 1 ray × 4 primitives) or a [`RayPacket`](crate::RayPacket) of any width (1, 4, 8, 16
-//! rays: one child box per lane operation, inactive lanes masked; N rays × 1 primitive in the
-//! leaves). Triangles use [`Watertight`](crate::triangle::Watertight), spheres
+//! rays, inactive lanes masked; N rays × 1 primitive in the leaves). A packet whose
+//! directions share their signs tests all 8 children of a node at once, for the whole packet,
+//! with interval bounds of its lanes' slab values (conservative because rounding is
+//! monotonic; a leaf child is then checked lane by lane); other packets test one child box
+//! per lane operation. Triangles use [`Watertight`](crate::triangle::Watertight), spheres
 //! [`Robust`](crate::sphere::Robust), two-sided unless [`Bvh::with_cull`] says otherwise.
+//! [`Bvh::focus`] gives the focal mode for rays from one eye ([`focal`]: per-eye planes and
+//! leaf vertices, the same answers).
 //!
 //! ```
 //! use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
