@@ -634,16 +634,12 @@ impl Frustum {
             inv: [(0.0, 0.0); 3],
             neg: [false; 3],
         };
-        let range = |x: L| {
-            let mut r = (f32::INFINITY, f32::NEG_INFINITY);
-            let mut bits = valid.bits();
-            while bits != 0 {
-                let v = lane_f32(x, bits.trailing_zeros() as usize);
-                bits &= bits - 1;
-                r = (r.0.min(v), r.1.max(v));
-            }
-            r
-        };
+        // Lanes with a non-finite constant take the per-child test (the ranges skip NaN).
+        let finite = |x: L| valid.and_not(x.is_finite()).none();
+        if !(0..3).all(|a| finite(s.on[a]) && finite(s.of[a]) && finite(s.inv[a])) {
+            return None;
+        }
+        let range = |x: L| (-highest(-x, valid), highest(x, valid));
         for a in 0..3 {
             let neg = s.neg[a] & valid;
             if neg.any() && valid.and_not(neg).any() {
@@ -691,14 +687,16 @@ impl Frustum {
     }
 }
 
-/// The highest `t_max` of the `valid` lanes.
+/// The highest value of the `valid` lanes (none NaN: valid rays have no NaN constants).
 #[inline(always)]
 fn highest<L: Lane>(t: L, valid: L::Mask) -> f32 {
+    let t = L::select(valid, t, L::from_f32(f32::NEG_INFINITY));
     let mut r = f32::NEG_INFINITY;
-    let mut bits = valid.bits();
-    while bits != 0 {
-        r = r.max(lane_f32(t, bits.trailing_zeros() as usize));
-        bits &= bits - 1;
+    for i in 0..L::LANES {
+        let v = lane_f32(t, i);
+        if v > r {
+            r = v;
+        }
     }
     r
 }
