@@ -18,12 +18,14 @@ fn grow(b: &mut Box3, lo: &[f32; 3], hi: &[f32; 3]) {
     }
 }
 
-fn range_box(s: &[Scratch]) -> Box3 {
-    let mut b = EMPTY_BOX;
+/// The box of `s`'s primitives and the box of their centroids, in one pass.
+fn range_boxes(s: &[Scratch]) -> (Box3, Box3) {
+    let (mut b, mut cb) = (EMPTY_BOX, EMPTY_BOX);
     for p in s {
         grow(&mut b, &p.lo, &p.hi);
+        grow(&mut cb, &p.c, &p.c);
     }
-    b
+    (b, cb)
 }
 
 /// Bin of centroid coordinate `c`: `⌊(c − cmin)·k⌋` clamped to `0…BINS−1` (`as` saturates,
@@ -34,87 +36,123 @@ fn bin(c: f32, cmin: f32, k: f32) -> usize {
     if b < BINS { b } else { BINS - 1 }
 }
 
-/// The binned SAH split of `s` (Wald 2007): `Some(mid)` with both sides non-empty, after
-/// partitioning `s` in place, or `None` when no plane separates the centroids (or every
-/// cost is NaN).
-fn sah_split(s: &mut [Scratch]) -> Option<usize> {
-    let mut cb = EMPTY_BOX;
-    for p in s.iter() {
-        grow(&mut cb, &p.c, &p.c);
-    }
-    let (cmin, cmax) = cb;
-    // (cost, axis, last bin of the left side, scale)
-    let mut best: Option<(f32, usize, usize, f32)> = None;
+/// A child range under construction: `s[start..end]`, the box of its primitives and the box
+/// of their centroids.
+#[derive(Clone, Copy)]
+struct Part {
+    start: u32,
+    end: u32,
+    b: Box3,
+    cb: Box3,
+}
+
+/// The binned SAH split of `s` (Wald 2007) given its centroids' box `cb`: after partitioning
+/// `s` in place, `Some((mid, left, right))` with both sides non-empty and their boxes and
+/// centroid boxes, or `None` when no plane separates the centroids (or every cost is NaN).
+///
+/// One pass bins the centroids on all three axes at once (16 bins each: count and box); a
+/// sweep per axis gives every plane's `A_L·N_L + A_R·N_R` and the children's boxes (prefix and
+/// suffix unions of the bins); the partition pass gathers the children's centroid boxes.
+fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Box3, Box3), (Box3, Box3))> {
+    let (cmin, cmax) = *cb;
+    let mut k = [0.0f32; 3];
+    let mut any = false;
     for axis in 0..3 {
         let ext = cmax[axis] - cmin[axis];
-        // Also skips NaN extents.
-        if ext.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
+        // Also skips NaN extents (k stays 0: every centroid in bin 0).
+        if ext > 0.0 {
+            k[axis] = BINS as f32 / ext;
+            any = true;
+        }
+    }
+    if !any {
+        return None;
+    }
+    let mut count = [[0u32; BINS]; 3];
+    let mut boxes = [[EMPTY_BOX; BINS]; 3];
+    for p in s.iter() {
+        for axis in 0..3 {
+            let b = bin(p.c[axis], cmin[axis], k[axis]);
+            count[axis][b] += 1;
+            grow(&mut boxes[axis][b], &p.lo, &p.hi);
+        }
+    }
+    // (cost, axis, last bin of the left side, left box, right box)
+    let mut best: Option<(f32, usize, usize, Box3, Box3)> = None;
+    for axis in 0..3 {
+        if k[axis] == 0.0 {
             continue;
         }
-        let k = BINS as f32 / ext;
-        let mut count = [0u32; BINS];
-        let mut boxes = [EMPTY_BOX; BINS];
-        for p in s.iter() {
-            let b = bin(p.c[axis], cmin[axis], k);
-            count[b] += 1;
-            grow(&mut boxes[b], &p.lo, &p.hi);
-        }
-        // Sweep: right-side areas and counts from the top, then left sides upward.
-        let mut right_area = [0.0f32; BINS];
-        let mut right_count = [0u32; BINS];
+        let (count, boxes) = (&count[axis], &boxes[axis]);
+        // Sweep: right-side boxes and counts from the top, then left sides upward.
+        let mut right = [(EMPTY_BOX, 0u32); BINS];
         let mut acc = EMPTY_BOX;
         let mut n = 0;
         for i in (1..BINS).rev() {
             grow(&mut acc, &boxes[i].0, &boxes[i].1);
             n += count[i];
-            right_area[i] = area(acc.0, acc.1);
-            right_count[i] = n;
+            right[i] = (acc, n);
         }
         let mut acc = EMPTY_BOX;
         let mut n = 0;
         for i in 0..BINS - 1 {
             grow(&mut acc, &boxes[i].0, &boxes[i].1);
             n += count[i];
-            let nr = right_count[i + 1];
+            let (rb, nr) = right[i + 1];
             if n == 0 || nr == 0 {
                 continue;
             }
-            let cost = area(acc.0, acc.1) * n as f32 + right_area[i + 1] * nr as f32;
+            let cost = area(acc.0, acc.1) * n as f32 + area(rb.0, rb.1) * nr as f32;
             if best.is_none_or(|b| cost < b.0) {
-                best = Some((cost, axis, i, k));
+                best = Some((cost, axis, i, acc, rb));
             }
         }
     }
-    let (cost, axis, last, k) = best?;
+    let (cost, axis, last, lb, rb) = best?;
     if cost.is_nan() {
         return None;
     }
-    // Partition in place: bins ≤ last to the left.
+    // Partition in place (Hoare: scan from both ends, swap the misplaced pairs): bins ≤ last
+    // to the left; the centroid boxes on the way.
+    let left = |p: &Scratch| bin(p.c[axis], cmin[axis], k[axis]) <= last;
+    let (mut lc, mut rc) = (EMPTY_BOX, EMPTY_BOX);
     let (mut i, mut j) = (0, s.len());
-    while i < j {
-        if bin(s[i].c[axis], cmin[axis], k) <= last {
+    loop {
+        while i < j && left(&s[i]) {
+            grow(&mut lc, &s[i].c, &s[i].c);
             i += 1;
-        } else {
-            j -= 1;
-            s.swap(i, j);
         }
+        while i < j && !left(&s[j - 1]) {
+            j -= 1;
+            grow(&mut rc, &s[j].c, &s[j].c);
+        }
+        if i == j {
+            break;
+        }
+        j -= 1;
+        s.swap(i, j);
+        grow(&mut lc, &s[i].c, &s[i].c);
+        grow(&mut rc, &s[j].c, &s[j].c);
+        i += 1;
     }
-    Some(i)
+    Some((i, (lb, lc), (rb, rc)))
 }
 
-/// Splits `s` (more than [`LEAF_WIDTH`] primitives) into two non-empty parts; returns the size
-/// of the first. Binned SAH above [`SAH_DEPTH`], the middle index (rounded up to a multiple of
-/// [`LEAF_WIDTH`]) below it or when SAH finds no plane.
-fn split(s: &mut [Scratch], depth: u32) -> usize {
+/// Splits `s` (more than [`LEAF_WIDTH`] primitives, centroid box `cb`) into two non-empty
+/// parts; returns the size of the first and both parts' boxes and centroid boxes. Binned SAH
+/// above [`SAH_DEPTH`], the middle index (rounded up to a multiple of [`LEAF_WIDTH`]) below it
+/// or when SAH finds no plane.
+fn split(s: &mut [Scratch], cb: &Box3, depth: u32) -> (usize, (Box3, Box3), (Box3, Box3)) {
     if depth < SAH_DEPTH
-        && let Some(mid) = sah_split(s)
+        && let Some(r) = sah_split(s, cb)
     {
-        return mid;
+        return r;
     }
     // The middle, rounded up to whole leaves where that leaves both sides non-empty.
     let half = s.len() / 2;
     let whole = half.div_ceil(LEAF_WIDTH) * LEAF_WIDTH;
-    if whole < s.len() { whole } else { half }
+    let mid = if whole < s.len() { whole } else { half };
+    (mid, range_boxes(&s[..mid]), range_boxes(&s[mid..]))
 }
 
 /// Builds a tree over `prims` into `nodes`, `leaves` (sizes from [`needed`]) using `scratch`
@@ -173,10 +211,8 @@ pub fn build<'s, P: Primitives + ?Sized>(
         jobs -= 1;
         let [node, start, end, depth] = s[jobs].job;
         // Children as ranges; split the one of largest area until WIDTH or all are leaves.
-        let mut kids = [(0u32, 0u32); WIDTH];
-        let mut boxes = [EMPTY_BOX; WIDTH];
-        kids[0] = (start, end);
-        boxes[0] = range_box(&s[start as usize..end as usize]);
+        let (b, cb) = range_boxes(&s[start as usize..end as usize]);
+        let mut kids = [Part { start, end, b, cb }; WIDTH];
         let mut nk = 1;
         while nk < WIDTH {
             // SAH levels split the largest area, middle-index levels the largest count (so
@@ -185,13 +221,13 @@ pub fn build<'s, P: Primitives + ?Sized>(
             let mut pick: Option<usize> = None;
             let mut best = f32::NEG_INFINITY;
             let mut best_count = 0;
-            for k in 0..nk {
-                let count = (kids[k].1 - kids[k].0) as usize;
+            for (k, kid) in kids[..nk].iter().enumerate() {
+                let count = (kid.end - kid.start) as usize;
                 if count <= LEAF_WIDTH {
                     continue;
                 }
                 let a = if depth < SAH_DEPTH {
-                    area(boxes[k].0, boxes[k].1)
+                    area(kid.b.0, kid.b.1)
                 } else {
                     count as f32
                 };
@@ -202,24 +238,35 @@ pub fn build<'s, P: Primitives + ?Sized>(
                 }
             }
             let Some(k) = pick else { break };
-            let (a, b) = kids[k];
-            let mid = a + split(&mut s[a as usize..b as usize], depth) as u32;
-            for j in (k + 1..nk).rev() {
-                kids[j + 1] = kids[j];
-                boxes[j + 1] = boxes[j];
-            }
-            kids[k] = (a, mid);
-            kids[k + 1] = (mid, b);
-            boxes[k] = range_box(&s[a as usize..mid as usize]);
-            boxes[k + 1] = range_box(&s[mid as usize..b as usize]);
+            let Part {
+                start: a,
+                end: b,
+                cb,
+                ..
+            } = kids[k];
+            let (mid, (lb, lcb), (rb, rcb)) = split(&mut s[a as usize..b as usize], &cb, depth);
+            let mid = a + mid as u32;
+            kids.copy_within(k + 1..nk, k + 2);
+            kids[k] = Part {
+                start: a,
+                end: mid,
+                b: lb,
+                cb: lcb,
+            };
+            kids[k + 1] = Part {
+                start: mid,
+                end: b,
+                b: rb,
+                cb: rcb,
+            };
             nk += 1;
         }
         let mut out = Node::EMPTY;
-        for k in 0..nk {
-            let (a, b) = kids[k];
+        for (k, kid) in kids[..nk].iter().enumerate() {
+            let (a, b) = (kid.start, kid.end);
             for axis in 0..3 {
-                out.bounds[axis][k] = boxes[k].0[axis];
-                out.bounds[3 + axis][k] = boxes[k].1[axis];
+                out.bounds[axis][k] = kid.b.0[axis];
+                out.bounds[3 + axis][k] = kid.b.1[axis];
             }
             if (b - a) as usize <= LEAF_WIDTH {
                 let slot = leaves
