@@ -18,11 +18,46 @@ fn grow(b: &mut Box3, lo: &[f32; 3], hi: &[f32; 3]) {
     }
 }
 
+/// A box as 8 lanes: min x, y, z, 0, then −max x, y, z, 0. The union of two boxes is one
+/// lane-wise [`min`] (one 8-lane operation where the target has it); negation is exact and
+/// `min(−a, −b) = −max(a, b)` bit for bit, so the boxes are those of [`grow`].
+type Lanes = [f32; 8];
+
+const EMPTY_LANES: Lanes = [
+    f32::INFINITY,
+    f32::INFINITY,
+    f32::INFINITY,
+    0.0,
+    f32::INFINITY,
+    f32::INFINITY,
+    f32::INFINITY,
+    0.0,
+];
+
+#[inline(always)]
+fn union(b: &mut Lanes, o: &Lanes) {
+    for l in 0..8 {
+        b[l] = min(b[l], o[l]);
+    }
+}
+
+/// `(min, max)` of a box in lanes.
+#[inline(always)]
+fn unlanes(b: &Lanes) -> Box3 {
+    ([b[0], b[1], b[2]], [-b[4], -b[5], -b[6]])
+}
+
+#[inline(always)]
+fn lanes_area(b: &Lanes) -> f32 {
+    let (lo, hi) = unlanes(b);
+    area(lo, hi)
+}
+
 /// The box of `s`'s primitives and the box of their centroids, in one pass.
-fn range_boxes(s: &[Scratch]) -> (Box3, Box3) {
-    let (mut b, mut cb) = (EMPTY_BOX, EMPTY_BOX);
+fn range_boxes(s: &[Scratch]) -> (Lanes, Box3) {
+    let (mut b, mut cb) = (EMPTY_LANES, EMPTY_BOX);
     for p in s {
-        grow(&mut b, &p.lo, &p.hi);
+        union(&mut b, &p.b);
         grow(&mut cb, &p.c, &p.c);
     }
     (b, cb)
@@ -32,7 +67,7 @@ fn range_boxes(s: &[Scratch]) -> (Box3, Box3) {
 /// NaN gives 0: the same bin on every target).
 #[inline(always)]
 fn bin(c: f32, cmin: f32, k: f32) -> usize {
-    let b = ((c - cmin) * k) as usize;
+    let b = ((c - cmin) * k) as i32 as usize;
     if b < BINS { b } else { BINS - 1 }
 }
 
@@ -42,7 +77,7 @@ fn bin(c: f32, cmin: f32, k: f32) -> usize {
 struct Part {
     start: u32,
     end: u32,
-    b: Box3,
+    b: Lanes,
     cb: Box3,
 }
 
@@ -51,9 +86,9 @@ struct Part {
 /// centroid boxes, or `None` when no plane separates the centroids (or every cost is NaN).
 ///
 /// One pass bins the centroids on all three axes at once (16 bins each: count and box); a
-/// sweep per axis gives every plane's `A_L·N_L + A_R·N_R` and the children's boxes (prefix and
-/// suffix unions of the bins); the partition pass gathers the children's centroid boxes.
-fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Box3, Box3), (Box3, Box3))> {
+/// sweep per axis gives every plane's `A_L·N_L + A_R·N_R`; the children's boxes are unions
+/// of the chosen axis's bins, and the partition pass gathers their centroid boxes.
+fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Lanes, Box3), (Lanes, Box3))> {
     let (cmin, cmax) = *cb;
     let mut k = [0.0f32; 3];
     let mut any = false;
@@ -69,48 +104,57 @@ fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Box3, Box3), (Box3
         return None;
     }
     let mut count = [[0u32; BINS]; 3];
-    let mut boxes = [[EMPTY_BOX; BINS]; 3];
+    let mut boxes = [[EMPTY_LANES; BINS]; 3];
     for p in s.iter() {
         for axis in 0..3 {
             let b = bin(p.c[axis], cmin[axis], k[axis]);
             count[axis][b] += 1;
-            grow(&mut boxes[axis][b], &p.lo, &p.hi);
+            union(&mut boxes[axis][b], &p.b);
         }
     }
-    // (cost, axis, last bin of the left side, left box, right box)
-    let mut best: Option<(f32, usize, usize, Box3, Box3)> = None;
+    // (cost, axis, last bin of the left side)
+    let mut best: Option<(f32, usize, usize)> = None;
     for axis in 0..3 {
         if k[axis] == 0.0 {
             continue;
         }
         let (count, boxes) = (&count[axis], &boxes[axis]);
-        // Sweep: right-side boxes and counts from the top, then left sides upward.
-        let mut right = [(EMPTY_BOX, 0u32); BINS];
-        let mut acc = EMPTY_BOX;
+        // Sweep: right-side areas and counts from the top, then left sides upward.
+        let mut right_area = [0.0f32; BINS];
+        let mut right_count = [0u32; BINS];
+        let mut acc = EMPTY_LANES;
         let mut n = 0;
         for i in (1..BINS).rev() {
-            grow(&mut acc, &boxes[i].0, &boxes[i].1);
+            union(&mut acc, &boxes[i]);
             n += count[i];
-            right[i] = (acc, n);
+            right_area[i] = lanes_area(&acc);
+            right_count[i] = n;
         }
-        let mut acc = EMPTY_BOX;
+        let mut acc = EMPTY_LANES;
         let mut n = 0;
         for i in 0..BINS - 1 {
-            grow(&mut acc, &boxes[i].0, &boxes[i].1);
+            union(&mut acc, &boxes[i]);
             n += count[i];
-            let (rb, nr) = right[i + 1];
+            let nr = right_count[i + 1];
             if n == 0 || nr == 0 {
                 continue;
             }
-            let cost = area(acc.0, acc.1) * n as f32 + area(rb.0, rb.1) * nr as f32;
+            let cost = lanes_area(&acc) * n as f32 + right_area[i + 1] * nr as f32;
             if best.is_none_or(|b| cost < b.0) {
-                best = Some((cost, axis, i, acc, rb));
+                best = Some((cost, axis, i));
             }
         }
     }
-    let (cost, axis, last, lb, rb) = best?;
+    let (cost, axis, last) = best?;
     if cost.is_nan() {
         return None;
+    }
+    let (mut lb, mut rb) = (EMPTY_LANES, EMPTY_LANES);
+    for b in &boxes[axis][..=last] {
+        union(&mut lb, b);
+    }
+    for b in boxes[axis][last + 1..].iter().rev() {
+        union(&mut rb, b);
     }
     // Partition in place (Hoare: scan from both ends, swap the misplaced pairs): bins ≤ last
     // to the left; the centroid boxes on the way.
@@ -142,7 +186,7 @@ fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Box3, Box3), (Box3
 /// parts; returns the size of the first and both parts' boxes and centroid boxes. Binned SAH
 /// above [`SAH_DEPTH`], the middle index (rounded up to a multiple of [`LEAF_WIDTH`]) below it
 /// or when SAH finds no plane.
-fn split(s: &mut [Scratch], cb: &Box3, depth: u32) -> (usize, (Box3, Box3), (Box3, Box3)) {
+fn split(s: &mut [Scratch], cb: &Box3, depth: u32) -> (usize, (Lanes, Box3), (Lanes, Box3)) {
     if depth < SAH_DEPTH
         && let Some(r) = sah_split(s, cb)
     {
@@ -191,8 +235,7 @@ pub fn build<'s, P: Primitives + ?Sized>(
             c[a] = if x.is_finite() { x } else { 0.0 };
         }
         *p = Scratch {
-            lo,
-            hi,
+            b: [lo[0], lo[1], lo[2], 0.0, -hi[0], -hi[1], -hi[2], 0.0],
             c,
             index: i as u32,
             job: [0; 4],
@@ -227,7 +270,7 @@ pub fn build<'s, P: Primitives + ?Sized>(
                     continue;
                 }
                 let a = if depth < SAH_DEPTH {
-                    area(kid.b.0, kid.b.1)
+                    lanes_area(&kid.b)
                 } else {
                     count as f32
                 };
@@ -264,9 +307,10 @@ pub fn build<'s, P: Primitives + ?Sized>(
         let mut out = Node::EMPTY;
         for (k, kid) in kids[..nk].iter().enumerate() {
             let (a, b) = (kid.start, kid.end);
+            let (lo, hi) = unlanes(&kid.b);
             for axis in 0..3 {
-                out.bounds[axis][k] = kid.b.0[axis];
-                out.bounds[3 + axis][k] = kid.b.1[axis];
+                out.bounds[axis][k] = lo[axis];
+                out.bounds[3 + axis][k] = hi[axis];
             }
             if (b - a) as usize <= LEAF_WIDTH {
                 let slot = leaves

@@ -166,11 +166,12 @@ impl Default for Node {
     }
 }
 
-/// The builder's working memory for one primitive (56 bytes; not needed after the build).
+/// The builder's working memory for one primitive (64 bytes; not needed after the build).
+#[repr(C)]
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Scratch {
-    pub(crate) lo: [f32; 3],
-    pub(crate) hi: [f32; 3],
+    /// The primitive's box: min x, y, z, 0, −max x, y, z, 0.
+    pub(crate) b: [f32; 8],
     pub(crate) c: [f32; 3],
     pub(crate) index: u32,
     pub(crate) job: [u32; 4],
