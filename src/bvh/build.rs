@@ -63,13 +63,34 @@ fn range_boxes(s: &[Scratch]) -> (Lanes, Box3) {
     (b, cb)
 }
 
-/// Bin of centroid coordinate `c`: `⌊(c − cmin)·k⌋` clamped to `0…BINS−1` (`as` saturates,
-/// NaN gives 0: the same bin on every target).
+/// Bin of centroid coordinate `c`: `⌊(c − cmin)·k⌋` clamped to `0…BINS−1`, NaN giving 0 (`as`
+/// saturates and maps NaN to 0: the same bin on every target, without branches).
 #[inline(always)]
 fn bin(c: f32, cmin: f32, k: f32) -> usize {
-    let b = ((c - cmin) * k) as i32 as usize;
-    if b < BINS { b } else { BINS - 1 }
+    const TOP: f32 = (BINS - 1) as f32;
+    let x = (c - cmin) * k;
+    (if x >= TOP { TOP } else { x }) as u8 as usize
 }
+
+/// Adds `p` to one copy of the bins (counts and boxes of the three axes).
+#[inline(always)]
+fn bin_one(
+    count: &mut [[u32; BINS]; 3],
+    boxes: &mut [[Lanes; BINS]; 3],
+    p: &Scratch,
+    cmin: &[f32; 3],
+    k: &[f32; 3],
+) {
+    for axis in 0..3 {
+        let b = bin(p.c[axis], cmin[axis], k[axis]);
+        count[axis][b] += 1;
+        union(&mut boxes[axis][b], &p.b);
+    }
+}
+
+/// Copies of the bins, filled by turns and merged after the pass: consecutive primitives
+/// often fall in the same bin, and separate copies let their updates overlap.
+const COPIES: usize = 2;
 
 /// A child range under construction: `s[start..end]`, the box of its primitives and the box
 /// of their centroids.
@@ -103,13 +124,27 @@ fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Lanes, Box3), (Lan
     if !any {
         return None;
     }
-    let mut count = [[0u32; BINS]; 3];
-    let mut boxes = [[EMPTY_LANES; BINS]; 3];
-    for p in s.iter() {
+    // Bins in COPIES copies filled by turns, then merged (copy 0 first).
+    let mut count = [[[0u32; BINS]; 3]; COPIES];
+    let mut boxes = [[[EMPTY_LANES; BINS]; 3]; COPIES];
+    let mut turns = s.chunks_exact(COPIES);
+    for ps in &mut turns {
+        for (h, p) in ps.iter().enumerate() {
+            bin_one(&mut count[h], &mut boxes[h], p, &cmin, &k);
+        }
+    }
+    for p in turns.remainder() {
+        bin_one(&mut count[0], &mut boxes[0], p, &cmin, &k);
+    }
+    let (first, rest) = boxes.split_at_mut(1);
+    let (count0, count_rest) = count.split_at_mut(1);
+    let (count, boxes) = (&mut count0[0], &mut first[0]);
+    for (c, b) in count_rest.iter().zip(rest.iter()) {
         for axis in 0..3 {
-            let b = bin(p.c[axis], cmin[axis], k[axis]);
-            count[axis][b] += 1;
-            union(&mut boxes[axis][b], &p.b);
+            for i in 0..BINS {
+                count[axis][i] += c[axis][i];
+                union(&mut boxes[axis][i], &b[axis][i]);
+            }
         }
     }
     // (cost, axis, last bin of the left side)
@@ -199,6 +234,29 @@ fn split(s: &mut [Scratch], cb: &Box3, depth: u32) -> (usize, (Lanes, Box3), (La
     (mid, range_boxes(&s[..mid]), range_boxes(&s[mid..]))
 }
 
+/// The end of the pending-node stack.
+const NONE: u32 = u32::MAX;
+
+/// A pending node's job, kept in its own slot until the node is built: `[start, end, depth,
+/// next pending node]` in `child[0..4]`, the range's box in `bounds[0]`, its centroids' box
+/// in `bounds[1][0..3]` (min) and `bounds[2][0..3]` (max).
+fn job(w: [u32; 4], b: &Lanes, cb: &Box3) -> Node {
+    let mut j = Node::EMPTY;
+    j.child[..4].copy_from_slice(&w);
+    j.bounds[0] = *b;
+    j.bounds[1][..3].copy_from_slice(&cb.0);
+    j.bounds[2][..3].copy_from_slice(&cb.1);
+    j
+}
+
+/// The job in a pending node's slot (see [`job`]).
+fn unjob(j: &Node) -> ([u32; 4], Lanes, Box3) {
+    let w = [j.child[0], j.child[1], j.child[2], j.child[3]];
+    let lo = [j.bounds[1][0], j.bounds[1][1], j.bounds[1][2]];
+    let hi = [j.bounds[2][0], j.bounds[2][1], j.bounds[2][2]];
+    (w, j.bounds[0], (lo, hi))
+}
+
 /// Builds a tree over `prims` into `nodes`, `leaves` (sizes from [`needed`]) using `scratch`
 /// as working memory. See the [module docs](super) for the algorithm and layout.
 ///
@@ -227,6 +285,7 @@ pub fn build<'s, P: Primitives + ?Sized>(
         return Err(BuildError::Scratch(need.scratch));
     }
     let s = &mut scratch[..n];
+    let (mut b, mut cb) = (EMPTY_LANES, EMPTY_BOX);
     for (i, p) in s.iter_mut().enumerate() {
         let (lo, hi) = prims.bounds(i as u32);
         let mut c = [0.0f32; 3];
@@ -238,23 +297,24 @@ pub fn build<'s, P: Primitives + ?Sized>(
             b: [lo[0], lo[1], lo[2], 0.0, -hi[0], -hi[1], -hi[2], 0.0],
             c,
             index: i as u32,
-            job: [0; 4],
         };
+        union(&mut b, &p.b);
+        grow(&mut cb, &c, &c);
     }
-    nodes[0] = Node::EMPTY;
     let (mut used_nodes, mut used_leaves) = (1usize, 0usize);
-    // Pending nodes: [node, start, end, depth] in `s[0..jobs].job` (disjoint ranges of more
-    // than LEAF_WIDTH primitives each, so fewer than n of them).
-    let mut jobs = 0usize;
+    // Pending nodes: a stack linked through their own slots, each holding its job until it
+    // is built (see `job`); `top` is the last pushed, NONE when empty.
+    let mut top = NONE;
+    nodes[0] = Node::EMPTY;
     if n > 0 {
-        s[0].job = [0, 0, n as u32, 1];
-        jobs = 1;
+        nodes[0] = job([0, n as u32, 1, NONE], &b, &cb);
+        top = 0;
     }
-    while jobs > 0 {
-        jobs -= 1;
-        let [node, start, end, depth] = s[jobs].job;
+    while top != NONE {
+        let node = top as usize;
+        let ([start, end, depth, next], b, cb) = unjob(&nodes[node]);
+        top = next;
         // Children as ranges; split the one of largest area until WIDTH or all are leaves.
-        let (b, cb) = range_boxes(&s[start as usize..end as usize]);
         let mut kids = [Part { start, end, b, cb }; WIDTH];
         let mut nk = 1;
         while nk < WIDTH {
@@ -326,14 +386,13 @@ pub fn build<'s, P: Primitives + ?Sized>(
                 if used_nodes >= nodes.len() {
                     return Err(BuildError::Nodes(used_nodes + 1));
                 }
-                nodes[used_nodes] = Node::EMPTY;
+                nodes[used_nodes] = job([a, b, depth + 1, top], &kid.b, &kid.cb);
                 out.child[k] = used_nodes as u32;
-                s[jobs].job = [used_nodes as u32, a, b, depth + 1];
-                jobs += 1;
+                top = used_nodes as u32;
                 used_nodes += 1;
             }
         }
-        nodes[node as usize] = out;
+        nodes[node] = out;
     }
     let nodes: &'s [Node] = &nodes[..used_nodes];
     let leaves: &'s [P::Leaf] = &leaves[..used_leaves];
