@@ -142,8 +142,10 @@ fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Lanes, Box3), (Lan
     for (c, b) in count_rest.iter().zip(rest.iter()) {
         for axis in 0..3 {
             for i in 0..BINS {
-                count[axis][i] += c[axis][i];
-                union(&mut boxes[axis][i], &b[axis][i]);
+                if c[axis][i] != 0 {
+                    count[axis][i] += c[axis][i];
+                    union(&mut boxes[axis][i], &b[axis][i]);
+                }
             }
         }
     }
@@ -154,26 +156,34 @@ fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Lanes, Box3), (Lan
             continue;
         }
         let (count, boxes) = (&count[axis], &boxes[axis]);
-        // Sweep: right-side areas and counts from the top, then left sides upward.
+        // Sweep: right-side areas and counts from the top, then left sides upward. Empty bins
+        // change nothing: the plane after one costs what the plane before it costs (which
+        // wins the tie), so they are skipped.
         let mut right_area = [0.0f32; BINS];
         let mut right_count = [0u32; BINS];
         let mut acc = EMPTY_LANES;
-        let mut n = 0;
+        let (mut n, mut a) = (0, 0.0);
         for i in (1..BINS).rev() {
-            union(&mut acc, &boxes[i]);
-            n += count[i];
-            right_area[i] = lanes_area(&acc);
+            if count[i] != 0 {
+                union(&mut acc, &boxes[i]);
+                n += count[i];
+                a = lanes_area(&acc);
+            }
+            right_area[i] = a;
             right_count[i] = n;
         }
         let mut acc = EMPTY_LANES;
         let mut n = 0;
         for i in 0..BINS - 1 {
-            union(&mut acc, &boxes[i]);
-            n += count[i];
             let nr = right_count[i + 1];
-            if n == 0 || nr == 0 {
+            if nr == 0 {
+                break;
+            }
+            if count[i] == 0 {
                 continue;
             }
+            union(&mut acc, &boxes[i]);
+            n += count[i];
             let cost = lanes_area(&acc) * n as f32 + right_area[i + 1] * nr as f32;
             if best.is_none_or(|b| cost < b.0) {
                 best = Some((cost, axis, i));

@@ -9,8 +9,10 @@
 //! allocation, no recursion, `no_std`. Short storage is an error value ([`BuildError`]).
 //!
 //! * **Binned SAH** (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies",
-//!   2007): primitive centroids in 16 bins per axis, a sweep over the 15 planes per axis for
-//!   the cheapest `A_L·N_L + A_R·N_R`, an in-place partition.
+//!   2007): primitive centroids in 16 bins per axis (all three axes in one pass), a sweep over
+//!   the 15 planes per axis for the cheapest `A_L·N_L + A_R·N_R`, an in-place partition. The
+//!   children's boxes are unions of bins and their centroid boxes are gathered by the
+//!   partition, so a split reads its range twice.
 //! * **Built wide directly**: a node starts with its whole range as one child and splits the
 //!   child of largest surface area (more than 4 primitives) until it has 8 children (as
 //!   Embree's wide builders do); a child of at most 4 primitives is one leaf.
