@@ -72,25 +72,43 @@ fn bin(c: f32, cmin: f32, k: f32) -> usize {
     (if x >= TOP { TOP } else { x }) as u8 as usize
 }
 
-/// Adds `p` to one copy of the bins (counts and boxes of the three axes).
-#[inline(always)]
-fn bin_one(
-    count: &mut [[u32; BINS]; 3],
-    boxes: &mut [[Lanes; BINS]; 3],
-    p: &Scratch,
-    cmin: &[f32; 3],
-    k: &[f32; 3],
-) {
-    for axis in 0..3 {
-        let b = bin(p.c[axis], cmin[axis], k[axis]);
-        count[axis][b] += 1;
-        union(&mut boxes[axis][b], &p.b);
+/// Counts and boxes of the bins of the three axes.
+struct Bins {
+    count: [[u32; BINS]; 3],
+    boxes: [[Lanes; BINS]; 3],
+}
+
+impl Bins {
+    const EMPTY: Bins = Bins {
+        count: [[0; BINS]; 3],
+        boxes: [[EMPTY_LANES; BINS]; 3],
+    };
+
+    /// Adds `p` (centroid bins from the minimum `cmin` and scales `k`).
+    #[inline(always)]
+    fn add(&mut self, p: &Scratch, cmin: &[f32; 3], k: &[f32; 3]) {
+        for axis in 0..3 {
+            let b = bin(p.c[axis], cmin[axis], k[axis]);
+            self.count[axis][b] += 1;
+            union(&mut self.boxes[axis][b], &p.b);
+        }
+    }
+
+    /// Adds the primitives of `o`.
+    fn merge(&mut self, o: &Bins) {
+        for axis in 0..3 {
+            for i in 0..BINS {
+                if o.count[axis][i] != 0 {
+                    self.count[axis][i] += o.count[axis][i];
+                    union(&mut self.boxes[axis][i], &o.boxes[axis][i]);
+                }
+            }
+        }
     }
 }
 
-/// Copies of the bins, filled by turns and merged after the pass: consecutive primitives
-/// often fall in the same bin, and separate copies let their updates overlap.
-const COPIES: usize = 2;
+/// Ranges of at least this many primitives are binned into two copies of the bins.
+const PAIRED: usize = 64;
 
 /// A child range under construction: `s[start..end]`, the box of its primitives and the box
 /// of their centroids.
@@ -124,31 +142,26 @@ fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Lanes, Box3), (Lan
     if !any {
         return None;
     }
-    // Bins in COPIES copies filled by turns, then merged (copy 0 first).
-    let mut count = [[[0u32; BINS]; 3]; COPIES];
-    let mut boxes = [[[EMPTY_LANES; BINS]; 3]; COPIES];
-    let mut turns = s.chunks_exact(COPIES);
-    for ps in &mut turns {
-        for (h, p) in ps.iter().enumerate() {
-            bin_one(&mut count[h], &mut boxes[h], p, &cmin, &k);
+    let mut bins = Bins::EMPTY;
+    if s.len() >= PAIRED {
+        // Two copies filled by turns, then merged: consecutive primitives often fall in the
+        // same bin, and the copies let their read-modify-writes overlap.
+        let mut odd = Bins::EMPTY;
+        let mut pairs = s.chunks_exact(2);
+        for pair in &mut pairs {
+            bins.add(&pair[0], &cmin, &k);
+            odd.add(&pair[1], &cmin, &k);
+        }
+        for p in pairs.remainder() {
+            bins.add(p, &cmin, &k);
+        }
+        bins.merge(&odd);
+    } else {
+        for p in s.iter() {
+            bins.add(p, &cmin, &k);
         }
     }
-    for p in turns.remainder() {
-        bin_one(&mut count[0], &mut boxes[0], p, &cmin, &k);
-    }
-    let (first, rest) = boxes.split_at_mut(1);
-    let (count0, count_rest) = count.split_at_mut(1);
-    let (count, boxes) = (&mut count0[0], &mut first[0]);
-    for (c, b) in count_rest.iter().zip(rest.iter()) {
-        for axis in 0..3 {
-            for i in 0..BINS {
-                if c[axis][i] != 0 {
-                    count[axis][i] += c[axis][i];
-                    union(&mut boxes[axis][i], &b[axis][i]);
-                }
-            }
-        }
-    }
+    let Bins { count, boxes } = &bins;
     // (cost, axis, last bin of the left side)
     let mut best: Option<(f32, usize, usize)> = None;
     for axis in 0..3 {
