@@ -53,8 +53,11 @@ fn lanes_area(b: &Lanes) -> f32 {
     area(lo, hi)
 }
 
+/// A range's box (in lanes) and its centroids' box.
+type Boxes = (Lanes, Box3);
+
 /// The box of `s`'s primitives and the box of their centroids, in one pass.
-fn range_boxes(s: &[Scratch]) -> (Lanes, Box3) {
+fn range_boxes(s: &[Scratch]) -> Boxes {
     let (mut b, mut cb) = (EMPTY_LANES, EMPTY_BOX);
     for p in s {
         union(&mut b, &p.b);
@@ -127,7 +130,7 @@ struct Part {
 /// One pass bins the centroids on all three axes at once (16 bins each: count and box); a
 /// sweep per axis gives every plane's `A_L·N_L + A_R·N_R`; the children's boxes are unions
 /// of the chosen axis's bins, and the partition pass gathers their centroid boxes.
-fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Lanes, Box3), (Lanes, Box3))> {
+fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, Boxes, Boxes)> {
     let (cmin, cmax) = *cb;
     let mut k = [0.0f32; 3];
     let mut any = false;
@@ -244,7 +247,7 @@ fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, (Lanes, Box3), (Lan
 /// parts; returns the size of the first and both parts' boxes and centroid boxes. Binned SAH
 /// above [`SAH_DEPTH`], the middle index (rounded up to a multiple of [`LEAF_WIDTH`]) below it
 /// or when SAH finds no plane.
-fn split(s: &mut [Scratch], cb: &Box3, depth: u32) -> (usize, (Lanes, Box3), (Lanes, Box3)) {
+fn split(s: &mut [Scratch], cb: &Box3, depth: u32) -> (usize, Boxes, Boxes) {
     if depth < SAH_DEPTH
         && let Some(r) = sah_split(s, cb)
     {
