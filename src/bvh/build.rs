@@ -18,103 +18,269 @@ fn grow(b: &mut Box3, lo: &[f32; 3], hi: &[f32; 3]) {
     }
 }
 
-fn range_box(s: &[Scratch]) -> Box3 {
-    let mut b = EMPTY_BOX;
-    for p in s {
-        grow(&mut b, &p.lo, &p.hi);
-    }
-    b
-}
+/// A box as 8 lanes: min x, y, z, 0, then −max x, y, z, 0. The union of two boxes is one
+/// lane-wise [`min`] (one 8-lane operation where the target has it); negation is exact and
+/// `min(−a, −b) = −max(a, b)` bit for bit, so the boxes are those of [`grow`].
+type Lanes = [f32; 8];
 
-/// Bin of centroid coordinate `c`: `⌊(c − cmin)·k⌋` clamped to `0…BINS−1` (`as` saturates,
-/// NaN gives 0: the same bin on every target).
+const EMPTY_LANES: Lanes = [
+    f32::INFINITY,
+    f32::INFINITY,
+    f32::INFINITY,
+    0.0,
+    f32::INFINITY,
+    f32::INFINITY,
+    f32::INFINITY,
+    0.0,
+];
+
 #[inline(always)]
-fn bin(c: f32, cmin: f32, k: f32) -> usize {
-    let b = ((c - cmin) * k) as usize;
-    if b < BINS { b } else { BINS - 1 }
+fn union(b: &mut Lanes, o: &Lanes) {
+    for l in 0..8 {
+        b[l] = min(b[l], o[l]);
+    }
 }
 
-/// The binned SAH split of `s` (Wald 2007): `Some(mid)` with both sides non-empty, after
-/// partitioning `s` in place, or `None` when no plane separates the centroids (or every
-/// cost is NaN).
-fn sah_split(s: &mut [Scratch]) -> Option<usize> {
-    let mut cb = EMPTY_BOX;
-    for p in s.iter() {
+/// `(min, max)` of a box in lanes.
+#[inline(always)]
+fn unlanes(b: &Lanes) -> Box3 {
+    ([b[0], b[1], b[2]], [-b[4], -b[5], -b[6]])
+}
+
+#[inline(always)]
+fn lanes_area(b: &Lanes) -> f32 {
+    let (lo, hi) = unlanes(b);
+    area(lo, hi)
+}
+
+/// A range's box (in lanes) and its centroids' box.
+type Boxes = (Lanes, Box3);
+
+/// The box of `s`'s primitives and the box of their centroids, in one pass.
+fn range_boxes(s: &[Scratch]) -> Boxes {
+    let (mut b, mut cb) = (EMPTY_LANES, EMPTY_BOX);
+    for p in s {
+        union(&mut b, &p.b);
         grow(&mut cb, &p.c, &p.c);
     }
-    let (cmin, cmax) = cb;
-    // (cost, axis, last bin of the left side, scale)
-    let mut best: Option<(f32, usize, usize, f32)> = None;
-    for axis in 0..3 {
-        let ext = cmax[axis] - cmin[axis];
-        // Also skips NaN extents.
-        if ext.partial_cmp(&0.0) != Some(core::cmp::Ordering::Greater) {
-            continue;
+    (b, cb)
+}
+
+/// Bin of centroid coordinate `c`: `⌊(c − cmin)·k⌋` clamped to `0…BINS−1`, NaN giving 0 (`as`
+/// saturates and maps NaN to 0: the same bin on every target, without branches).
+#[inline(always)]
+fn bin(c: f32, cmin: f32, k: f32) -> usize {
+    const TOP: f32 = (BINS - 1) as f32;
+    let x = (c - cmin) * k;
+    (if x >= TOP { TOP } else { x }) as u8 as usize
+}
+
+/// Counts and boxes of the bins of the three axes.
+struct Bins {
+    count: [[u32; BINS]; 3],
+    boxes: [[Lanes; BINS]; 3],
+}
+
+impl Bins {
+    const EMPTY: Bins = Bins {
+        count: [[0; BINS]; 3],
+        boxes: [[EMPTY_LANES; BINS]; 3],
+    };
+
+    /// Adds `p` (centroid bins from the minimum `cmin` and scales `k`).
+    #[inline(always)]
+    fn add(&mut self, p: &Scratch, cmin: &[f32; 3], k: &[f32; 3]) {
+        for axis in 0..3 {
+            let b = bin(p.c[axis], cmin[axis], k[axis]);
+            self.count[axis][b] += 1;
+            union(&mut self.boxes[axis][b], &p.b);
         }
-        let k = BINS as f32 / ext;
-        let mut count = [0u32; BINS];
-        let mut boxes = [EMPTY_BOX; BINS];
-        for p in s.iter() {
-            let b = bin(p.c[axis], cmin[axis], k);
-            count[b] += 1;
-            grow(&mut boxes[b], &p.lo, &p.hi);
-        }
-        // Sweep: right-side areas and counts from the top, then left sides upward.
-        let mut right_area = [0.0f32; BINS];
-        let mut right_count = [0u32; BINS];
-        let mut acc = EMPTY_BOX;
-        let mut n = 0;
-        for i in (1..BINS).rev() {
-            grow(&mut acc, &boxes[i].0, &boxes[i].1);
-            n += count[i];
-            right_area[i] = area(acc.0, acc.1);
-            right_count[i] = n;
-        }
-        let mut acc = EMPTY_BOX;
-        let mut n = 0;
-        for i in 0..BINS - 1 {
-            grow(&mut acc, &boxes[i].0, &boxes[i].1);
-            n += count[i];
-            let nr = right_count[i + 1];
-            if n == 0 || nr == 0 {
-                continue;
-            }
-            let cost = area(acc.0, acc.1) * n as f32 + right_area[i + 1] * nr as f32;
-            if best.is_none_or(|b| cost < b.0) {
-                best = Some((cost, axis, i, k));
+    }
+
+    /// Adds the primitives of `o`.
+    fn merge(&mut self, o: &Bins) {
+        for axis in 0..3 {
+            for i in 0..BINS {
+                if o.count[axis][i] != 0 {
+                    self.count[axis][i] += o.count[axis][i];
+                    union(&mut self.boxes[axis][i], &o.boxes[axis][i]);
+                }
             }
         }
     }
-    let (cost, axis, last, k) = best?;
+}
+
+/// Ranges of at least this many primitives are binned into two copies of the bins.
+const PAIRED: usize = 64;
+
+/// A child range under construction: `s[start..end]`, the box of its primitives and the box
+/// of their centroids.
+#[derive(Clone, Copy)]
+struct Part {
+    start: u32,
+    end: u32,
+    b: Lanes,
+    cb: Box3,
+}
+
+/// The binned SAH split of `s` (Wald 2007) given its centroids' box `cb`: after partitioning
+/// `s` in place, `Some((mid, left, right))` with both sides non-empty and their boxes and
+/// centroid boxes, or `None` when no plane separates the centroids (or every cost is NaN).
+///
+/// One pass bins the centroids on all three axes at once (16 bins each: count and box); a
+/// sweep per axis gives every plane's `A_L·N_L + A_R·N_R`; the children's boxes are unions
+/// of the chosen axis's bins, and the partition pass gathers their centroid boxes.
+fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, Boxes, Boxes)> {
+    let (cmin, cmax) = *cb;
+    let mut k = [0.0f32; 3];
+    let mut any = false;
+    for axis in 0..3 {
+        let ext = cmax[axis] - cmin[axis];
+        // Also skips NaN extents (k stays 0: every centroid in bin 0).
+        if ext > 0.0 {
+            k[axis] = BINS as f32 / ext;
+            any = true;
+        }
+    }
+    if !any {
+        return None;
+    }
+    let mut bins = Bins::EMPTY;
+    if s.len() >= PAIRED {
+        // Two copies filled by turns, then merged: consecutive primitives often fall in the
+        // same bin, and the copies let their read-modify-writes overlap.
+        let mut odd = Bins::EMPTY;
+        let mut pairs = s.chunks_exact(2);
+        for pair in &mut pairs {
+            bins.add(&pair[0], &cmin, &k);
+            odd.add(&pair[1], &cmin, &k);
+        }
+        for p in pairs.remainder() {
+            bins.add(p, &cmin, &k);
+        }
+        bins.merge(&odd);
+    } else {
+        for p in s.iter() {
+            bins.add(p, &cmin, &k);
+        }
+    }
+    let Bins { count, boxes } = &bins;
+    // (cost, axis, last bin of the left side)
+    let mut best: Option<(f32, usize, usize)> = None;
+    for axis in 0..3 {
+        if k[axis] == 0.0 {
+            continue;
+        }
+        let (count, boxes) = (&count[axis], &boxes[axis]);
+        // Sweep: right-side areas and counts from the top, then left sides upward. Empty bins
+        // change nothing: the plane after one costs what the plane before it costs (which
+        // wins the tie), so they are skipped.
+        let mut right_area = [0.0f32; BINS];
+        let mut right_count = [0u32; BINS];
+        let mut acc = EMPTY_LANES;
+        let (mut n, mut a) = (0, 0.0);
+        for i in (1..BINS).rev() {
+            if count[i] != 0 {
+                union(&mut acc, &boxes[i]);
+                n += count[i];
+                a = lanes_area(&acc);
+            }
+            right_area[i] = a;
+            right_count[i] = n;
+        }
+        let mut acc = EMPTY_LANES;
+        let mut n = 0;
+        for i in 0..BINS - 1 {
+            let nr = right_count[i + 1];
+            if nr == 0 {
+                break;
+            }
+            if count[i] == 0 {
+                continue;
+            }
+            union(&mut acc, &boxes[i]);
+            n += count[i];
+            let cost = lanes_area(&acc) * n as f32 + right_area[i + 1] * nr as f32;
+            if best.is_none_or(|b| cost < b.0) {
+                best = Some((cost, axis, i));
+            }
+        }
+    }
+    let (cost, axis, last) = best?;
     if cost.is_nan() {
         return None;
     }
-    // Partition in place: bins ≤ last to the left.
-    let (mut i, mut j) = (0, s.len());
-    while i < j {
-        if bin(s[i].c[axis], cmin[axis], k) <= last {
-            i += 1;
-        } else {
-            j -= 1;
-            s.swap(i, j);
-        }
+    let (mut lb, mut rb) = (EMPTY_LANES, EMPTY_LANES);
+    for b in &boxes[axis][..=last] {
+        union(&mut lb, b);
     }
-    Some(i)
+    for b in boxes[axis][last + 1..].iter().rev() {
+        union(&mut rb, b);
+    }
+    // Partition in place (Hoare: scan from both ends, swap the misplaced pairs): bins ≤ last
+    // to the left; the centroid boxes on the way.
+    let left = |p: &Scratch| bin(p.c[axis], cmin[axis], k[axis]) <= last;
+    let (mut lc, mut rc) = (EMPTY_BOX, EMPTY_BOX);
+    let (mut i, mut j) = (0, s.len());
+    loop {
+        while i < j && left(&s[i]) {
+            grow(&mut lc, &s[i].c, &s[i].c);
+            i += 1;
+        }
+        while i < j && !left(&s[j - 1]) {
+            j -= 1;
+            grow(&mut rc, &s[j].c, &s[j].c);
+        }
+        if i == j {
+            break;
+        }
+        j -= 1;
+        s.swap(i, j);
+        grow(&mut lc, &s[i].c, &s[i].c);
+        grow(&mut rc, &s[j].c, &s[j].c);
+        i += 1;
+    }
+    Some((i, (lb, lc), (rb, rc)))
 }
 
-/// Splits `s` (more than [`LEAF_WIDTH`] primitives) into two non-empty parts; returns the size
-/// of the first. Binned SAH above [`SAH_DEPTH`], the middle index (rounded up to a multiple of
-/// [`LEAF_WIDTH`]) below it or when SAH finds no plane.
-fn split(s: &mut [Scratch], depth: u32) -> usize {
+/// Splits `s` (more than [`LEAF_WIDTH`] primitives, centroid box `cb`) into two non-empty
+/// parts; returns the size of the first and both parts' boxes and centroid boxes. Binned SAH
+/// above [`SAH_DEPTH`], the middle index (rounded up to a multiple of [`LEAF_WIDTH`]) below it
+/// or when SAH finds no plane.
+fn split(s: &mut [Scratch], cb: &Box3, depth: u32) -> (usize, Boxes, Boxes) {
     if depth < SAH_DEPTH
-        && let Some(mid) = sah_split(s)
+        && let Some(r) = sah_split(s, cb)
     {
-        return mid;
+        return r;
     }
     // The middle, rounded up to whole leaves where that leaves both sides non-empty.
     let half = s.len() / 2;
     let whole = half.div_ceil(LEAF_WIDTH) * LEAF_WIDTH;
-    if whole < s.len() { whole } else { half }
+    let mid = if whole < s.len() { whole } else { half };
+    (mid, range_boxes(&s[..mid]), range_boxes(&s[mid..]))
+}
+
+/// The end of the pending-node stack.
+const NONE: u32 = u32::MAX;
+
+/// A pending node's job, kept in its own slot until the node is built: `[start, end, depth,
+/// next pending node]` in `child[0..4]`, the range's box in `bounds[0]`, its centroids' box
+/// in `bounds[1][0..3]` (min) and `bounds[2][0..3]` (max).
+fn job(w: [u32; 4], b: &Lanes, cb: &Box3) -> Node {
+    let mut j = Node::EMPTY;
+    j.child[..4].copy_from_slice(&w);
+    j.bounds[0] = *b;
+    j.bounds[1][..3].copy_from_slice(&cb.0);
+    j.bounds[2][..3].copy_from_slice(&cb.1);
+    j
+}
+
+/// The job in a pending node's slot (see [`job`]).
+fn unjob(j: &Node) -> ([u32; 4], Lanes, Box3) {
+    let w = [j.child[0], j.child[1], j.child[2], j.child[3]];
+    let lo = [j.bounds[1][0], j.bounds[1][1], j.bounds[1][2]];
+    let hi = [j.bounds[2][0], j.bounds[2][1], j.bounds[2][2]];
+    (w, j.bounds[0], (lo, hi))
 }
 
 /// Builds a tree over `prims` into `nodes`, `leaves` (sizes from [`needed`]) using `scratch`
@@ -145,6 +311,7 @@ pub fn build<'s, P: Primitives + ?Sized>(
         return Err(BuildError::Scratch(need.scratch));
     }
     let s = &mut scratch[..n];
+    let (mut b, mut cb) = (EMPTY_LANES, EMPTY_BOX);
     for (i, p) in s.iter_mut().enumerate() {
         let (lo, hi) = prims.bounds(i as u32);
         let mut c = [0.0f32; 3];
@@ -153,30 +320,28 @@ pub fn build<'s, P: Primitives + ?Sized>(
             c[a] = if x.is_finite() { x } else { 0.0 };
         }
         *p = Scratch {
-            lo,
-            hi,
+            b: [lo[0], lo[1], lo[2], 0.0, -hi[0], -hi[1], -hi[2], 0.0],
             c,
             index: i as u32,
-            job: [0; 4],
         };
+        union(&mut b, &p.b);
+        grow(&mut cb, &c, &c);
     }
-    nodes[0] = Node::EMPTY;
     let (mut used_nodes, mut used_leaves) = (1usize, 0usize);
-    // Pending nodes: [node, start, end, depth] in `s[0..jobs].job` (disjoint ranges of more
-    // than LEAF_WIDTH primitives each, so fewer than n of them).
-    let mut jobs = 0usize;
+    // Pending nodes: a stack linked through their own slots, each holding its job until it
+    // is built (see `job`); `top` is the last pushed, NONE when empty.
+    let mut top = NONE;
+    nodes[0] = Node::EMPTY;
     if n > 0 {
-        s[0].job = [0, 0, n as u32, 1];
-        jobs = 1;
+        nodes[0] = job([0, n as u32, 1, NONE], &b, &cb);
+        top = 0;
     }
-    while jobs > 0 {
-        jobs -= 1;
-        let [node, start, end, depth] = s[jobs].job;
+    while top != NONE {
+        let node = top as usize;
+        let ([start, end, depth, next], b, cb) = unjob(&nodes[node]);
+        top = next;
         // Children as ranges; split the one of largest area until WIDTH or all are leaves.
-        let mut kids = [(0u32, 0u32); WIDTH];
-        let mut boxes = [EMPTY_BOX; WIDTH];
-        kids[0] = (start, end);
-        boxes[0] = range_box(&s[start as usize..end as usize]);
+        let mut kids = [Part { start, end, b, cb }; WIDTH];
         let mut nk = 1;
         while nk < WIDTH {
             // SAH levels split the largest area, middle-index levels the largest count (so
@@ -185,13 +350,13 @@ pub fn build<'s, P: Primitives + ?Sized>(
             let mut pick: Option<usize> = None;
             let mut best = f32::NEG_INFINITY;
             let mut best_count = 0;
-            for k in 0..nk {
-                let count = (kids[k].1 - kids[k].0) as usize;
+            for (k, kid) in kids[..nk].iter().enumerate() {
+                let count = (kid.end - kid.start) as usize;
                 if count <= LEAF_WIDTH {
                     continue;
                 }
                 let a = if depth < SAH_DEPTH {
-                    area(boxes[k].0, boxes[k].1)
+                    lanes_area(&kid.b)
                 } else {
                     count as f32
                 };
@@ -202,24 +367,36 @@ pub fn build<'s, P: Primitives + ?Sized>(
                 }
             }
             let Some(k) = pick else { break };
-            let (a, b) = kids[k];
-            let mid = a + split(&mut s[a as usize..b as usize], depth) as u32;
-            for j in (k + 1..nk).rev() {
-                kids[j + 1] = kids[j];
-                boxes[j + 1] = boxes[j];
-            }
-            kids[k] = (a, mid);
-            kids[k + 1] = (mid, b);
-            boxes[k] = range_box(&s[a as usize..mid as usize]);
-            boxes[k + 1] = range_box(&s[mid as usize..b as usize]);
+            let Part {
+                start: a,
+                end: b,
+                cb,
+                ..
+            } = kids[k];
+            let (mid, (lb, lcb), (rb, rcb)) = split(&mut s[a as usize..b as usize], &cb, depth);
+            let mid = a + mid as u32;
+            kids.copy_within(k + 1..nk, k + 2);
+            kids[k] = Part {
+                start: a,
+                end: mid,
+                b: lb,
+                cb: lcb,
+            };
+            kids[k + 1] = Part {
+                start: mid,
+                end: b,
+                b: rb,
+                cb: rcb,
+            };
             nk += 1;
         }
         let mut out = Node::EMPTY;
-        for k in 0..nk {
-            let (a, b) = kids[k];
+        for (k, kid) in kids[..nk].iter().enumerate() {
+            let (a, b) = (kid.start, kid.end);
+            let (lo, hi) = unlanes(&kid.b);
             for axis in 0..3 {
-                out.bounds[axis][k] = boxes[k].0[axis];
-                out.bounds[3 + axis][k] = boxes[k].1[axis];
+                out.bounds[axis][k] = lo[axis];
+                out.bounds[3 + axis][k] = hi[axis];
             }
             if (b - a) as usize <= LEAF_WIDTH {
                 let slot = leaves
@@ -235,14 +412,13 @@ pub fn build<'s, P: Primitives + ?Sized>(
                 if used_nodes >= nodes.len() {
                     return Err(BuildError::Nodes(used_nodes + 1));
                 }
-                nodes[used_nodes] = Node::EMPTY;
+                nodes[used_nodes] = job([a, b, depth + 1, top], &kid.b, &kid.cb);
                 out.child[k] = used_nodes as u32;
-                s[jobs].job = [used_nodes as u32, a, b, depth + 1];
-                jobs += 1;
+                top = used_nodes as u32;
                 used_nodes += 1;
             }
         }
-        nodes[node as usize] = out;
+        nodes[node] = out;
     }
     let nodes: &'s [Node] = &nodes[..used_nodes];
     let leaves: &'s [P::Leaf] = &leaves[..used_leaves];
