@@ -19,9 +19,9 @@
 //!
 //! | traversal | 1 ray | packets of 8 | packets of 16 |
 //! | --- | ---: | ---: | ---: |
-//! | world ([`Bvh`]) | 1,047 | 482 | 496 |
-//! | focal, planes minus the eye ([`FocalNode`], the default) | 1,060 | 481 | 504 |
-//! | focal, the lecture's focal sphere test ([`SphereNode`]) | 1,720 | 942 | 911 |
+//! | world ([`Bvh`]) | 1,047 | 404 | 409 |
+//! | focal, planes minus the eye ([`FocalNode`], the default) | 1,060 | 401 | 419 |
+//! | focal, the lecture's focal sphere test ([`SphereNode`]) | 1,720 | 875 | 836 |
 //!
 //! The lecture's focal sphere test (a sphere around each child's box, `C − E` and
 //! `|C − E|² − r²` cached: 4 mul and 2 add per child for unit directions, 1 more mul
