@@ -1,5 +1,7 @@
 //! Traversal: one ray (children in `f32x8` lanes, leaves in `f32x4` lanes) and packets of any
-//! width (one child box per lane operation).
+//! width (a node's 8 children in one interval test when the directions share their signs,
+//! otherwise one child box per lane operation), over the tree's boxes or a per-eye cache
+//! ([`View`]).
 
 use glam::Vec3;
 use wide::{f32x4, f32x8};
