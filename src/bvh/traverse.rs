@@ -710,6 +710,11 @@ fn frustum<L: Lane>(
     rays: &RayPacket<L>,
     valid: L::Mask,
 ) -> Option<(Frustum, f32, f32)> {
+    // One lane: its own per-child test is as tight and, where `f32x8` is emulated (Cortex-M),
+    // cheaper (4,941 against 9,447 instructions per primary ray on the M4F).
+    if L::LANES == 1 {
+        return None;
+    }
     let f = Frustum::new(slab, valid)?;
     let lo = -highest(-rays.t_min, valid);
     Some((f, lo, highest(rays.t_max, valid)))
