@@ -227,12 +227,22 @@ pub fn focal_closest1<P: Leaf>(
     rays: &[Ray],
     out: Option<&mut Answers>,
 ) -> u32 {
+    focused(t, eye, store, |f| bvh_closest1(f, rays, out))
+}
+
+/// `run` on `t` focused on `eye` in `store`'s storage.
+fn focused<P: Leaf, R>(
+    t: &Bvh<P>,
+    eye: Vec3,
+    store: &FocalStore<P>,
+    run: impl FnOnce(&bvh::FocalBvh<'_, '_, P>) -> R,
+) -> R {
     let mut s = store.borrow_mut();
     let (nodes, leaves) = &mut *s;
     let f = t
         .focus(eye, nodes, leaves)
         .expect("storage from focal_needed");
-    bvh_closest1(&f, rays, out)
+    run(&f)
 }
 
 /// Closest hits of ray packets through `t` focused on `eye` (the focus inside the timing).
@@ -245,12 +255,7 @@ pub fn focal_closest<P: Leaf, L: Lane<Scalar = f32>>(
     rays: usize,
     out: Option<&mut Answers>,
 ) -> u32 {
-    let mut s = store.borrow_mut();
-    let (nodes, leaves) = &mut *s;
-    let f = t
-        .focus(eye, nodes, leaves)
-        .expect("storage from focal_needed");
-    bvh_closest(&f, packets, rays, out)
+    focused(t, eye, store, |f| bvh_closest(f, packets, rays, out))
 }
 
 /// Closest hits of single rays through the BVH.

@@ -148,9 +148,7 @@ impl NodeCache for SphereNode {
         rows: [[0.0; WIDTH]; 5],
     };
     fn make(n: &Node, e: [f32; 3], m: f32) -> Self {
-        let mut s = SphereNode {
-            rows: [[0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0]; 5],
-        };
+        let mut s = <Self as NodeCache>::EMPTY;
         for k in 0..WIDTH {
             let lo = [0, 1, 2].map(|a| f64::from(n.bounds[a][k]));
             let hi = [3, 4, 5].map(|a| f64::from(n.bounds[a][k]));
@@ -430,7 +428,7 @@ impl<P: Leaf, N: NodeCache> View<P> for FocalBvh<'_, '_, P, N> {
         match self.nodes.get(c as usize).map(N::rows) {
             Some(NodeRows::Boxes(r)) => slab.test_rows::<true>(n, r, t_min, t_max),
             Some(NodeRows::Spheres(r)) if !slab.all => spheres_one(r, *x, slab.dir(), t_min, t_max),
-            _ => slab.test_rows::<false>(n, &n.bounds, t_min, t_max),
+            _ => slab.test(n, t_min, t_max),
         }
     }
     #[inline(always)]

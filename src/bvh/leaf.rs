@@ -76,23 +76,31 @@ pub trait Leaf: Packed {
     const REL_EMPTY: Self::Rel;
     /// The cache entry for rays from `eye`.
     fn relative(&self, eye: Vec3) -> Self::Rel;
-    /// [`test_four`](Self::test_four) for rays from the eye `rel` was made for: the same bits.
+    /// [`test_four`](Self::test_four) for rays from the eye `rel` was made for: the same bits
+    /// (by default `test_four` itself, for leaves that cache nothing).
+    #[inline(always)]
     fn test_four_rel(
         &self,
-        rel: &Self::Rel,
+        _rel: &Self::Rel,
         ray: &RayPacket<f32x4>,
         pre: &Self::Rays<f32x4>,
         cull: Cull,
-    ) -> LaneHit<f32x4>;
-    /// [`test_one`](Self::test_one) for rays from the eye `rel` was made for: the same bits.
+    ) -> LaneHit<f32x4> {
+        self.test_four(ray, pre, cull)
+    }
+    /// [`test_one`](Self::test_one) for rays from the eye `rel` was made for: the same bits
+    /// (by default `test_one` itself).
+    #[inline(always)]
     fn test_one_rel<L: Lane>(
         &self,
-        rel: &Self::Rel,
+        _rel: &Self::Rel,
         k: usize,
         rays: &RayPacket<L>,
         pre: &Self::Rays<L>,
         cull: Cull,
-    ) -> LaneHit<L>;
+    ) -> LaneHit<L> {
+        self.test_one(k, rays, pre, cull)
+    }
 }
 
 /// Four triangles' vertices minus an eye (`A − E`, `B − E`, `C − E`, each coordinate rounded
@@ -412,29 +420,6 @@ impl Leaf for Sphere4 {
 
     #[inline(always)]
     fn relative(&self, _eye: Vec3) {}
-
-    #[inline(always)]
-    fn test_four_rel(
-        &self,
-        _: &(),
-        ray: &RayPacket<f32x4>,
-        pre: &(),
-        cull: Cull,
-    ) -> LaneHit<f32x4> {
-        self.test_four(ray, pre, cull)
-    }
-
-    #[inline(always)]
-    fn test_one_rel<L: Lane>(
-        &self,
-        _: &(),
-        k: usize,
-        rays: &RayPacket<L>,
-        pre: &(),
-        cull: Cull,
-    ) -> LaneHit<L> {
-        self.test_one(k, rays, pre, cull)
-    }
 }
 
 /// `h` with primitive index `index` in every lane that hit (the one-element set's records

@@ -120,7 +120,7 @@ impl<P: Leaf> View<P> for World {
         t_min: f32,
         t_max: f32,
     ) -> (u32, f32x8) {
-        slab.test_rows::<false>(n, &n.bounds, t_min, t_max)
+        slab.test(n, t_min, t_max)
     }
     #[inline(always)]
     fn node_many<L: Lane>(

@@ -8,7 +8,9 @@ use crate::query::bits;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
-use raylane::bvh::{self, BuildError, Bvh, FocalLeaf, FocalNode, Leaf, NodeCache, SphereNode};
+use raylane::bvh::{
+    self, BuildError, Bvh, FocalLeaf, FocalNode, Leaf, Node, NodeCache, SphereNode, Tri4,
+};
 use raylane::mesh::Mesh;
 use raylane::sphere::{Robust, Sphere};
 use raylane::triangle::{Cull, Triangle};
@@ -90,19 +92,30 @@ fn focal_spheres_equal_brute_force() {
     }
 }
 
-/// The vendored bunny from eyes near and far (and one inside its box), with every width.
-#[test]
-fn focal_bunny_equals_brute_force_and_fills_lazily() {
+/// The vendored bunny's tree (nodes, leaves), its triangles as a flat set, and the centre and
+/// half-diagonal of its box.
+fn bunny() -> (Vec<Node>, Vec<Tri4>, Vec<Triangle>, Vec3, f32) {
     let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
     let mesh = Mesh::new(&m.pos, &m.idx);
     let (nodes, leaves) = owned(&mesh);
-    let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
-    let tris = flat(&mesh);
     let (lo, hi) = m.pos.iter().fold(
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(l, h), &p| (l.min(p), h.max(p)),
     );
-    let (c, r) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
+    (
+        nodes,
+        leaves,
+        flat(&mesh),
+        (lo + hi) * 0.5,
+        (hi - lo).length() * 0.5,
+    )
+}
+
+/// The vendored bunny from eyes near and far (and one inside its box), with every width.
+#[test]
+fn focal_bunny_equals_brute_force_and_fills_lazily() {
+    let (nodes, leaves, tris, c, r) = bunny();
+    let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
     let mut rng = SmallRng::seed_from_u64(143);
     let (mut fnodes, mut fleaves) = storage(&tree);
     for k in 0..8 {
@@ -204,16 +217,8 @@ fn focal_storage_and_bad_eyes() {
 /// mode, at every width.
 #[test]
 fn coherent_packets_equal_brute_force() {
-    let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
-    let mesh = Mesh::new(&m.pos, &m.idx);
-    let (nodes, leaves) = owned(&mesh);
+    let (nodes, leaves, tris, c, r) = bunny();
     let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
-    let tris = flat(&mesh);
-    let (lo, hi) = m.pos.iter().fold(
-        (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
-        |(l, h), &p| (l.min(p), h.max(p)),
-    );
-    let (c, r) = ((lo + hi) * 0.5, (hi - lo).length() * 0.5);
     let (mut fnodes, mut fleaves) = storage(&tree);
     let mut rng = SmallRng::seed_from_u64(145);
     for k in 0..4 {
