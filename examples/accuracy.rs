@@ -4,7 +4,7 @@
 //! cargo run --release --features vectors --example accuracy [-- --lanes 1|4|8|16] [--write] [DIR]
 //! ```
 //!
-//! Reads each class's vector file (`raylane::vectors::accuracy::CLASSES`) from `DIR` (default
+//! Reads each class's vector file (`raylane_lab::vectors::accuracy::CLASSES`) from `DIR` (default
 //! `tests/vectors`), runs every method of its kind, and prints the Markdown tables: the largest
 //! relative `t` error and absolute `u`, `v` error against the exact answers, then the same over
 //! each case's recorded conditioning. `tests/suite/accuracy.rs` pins this output
@@ -13,8 +13,8 @@
 
 use std::process::ExitCode;
 
-use raylane::vectors::accuracy::{self, Class};
-use raylane::vectors::{Case, Method, Outcome};
+use raylane_lab::vectors::accuracy::{self, Class};
+use raylane_lab::vectors::{Case, Method, Outcome};
 
 fn main() -> ExitCode {
     let mut lanes = 1usize;

@@ -7,7 +7,7 @@
 //! Evaluates every case of the files with one method (default: the recommended general
 //! method of each kind) at one lane width, cases batched into the lanes. Prints each failing
 //! case (with its tolerance per value: relative for `t`, absolute for `u`, `v`, widened by the
-//! line's recorded conditioning, see `raylane::vectors::tolerance`), the number of cases
+//! line's recorded conditioning, see `raylane_lab::vectors::tolerance`), the number of cases
 //! outside the method's documented limits, and a closing line
 //! `N passed, M failed`; exits non-zero on any failure. With `--emit` it compares nothing and
 //! prints one line per case, in file order: `miss` or the computed values (shortest round-trip
@@ -17,7 +17,7 @@
 
 use std::process::ExitCode;
 
-use raylane::vectors::{self, Case, Kind, Method, Outcome, Verdict};
+use raylane_lab::vectors::{self, Case, Kind, Method, Outcome, Verdict};
 
 fn usage() -> ExitCode {
     let names: Vec<_> = Method::ALL.iter().map(|m| m.name()).collect();

@@ -10,7 +10,7 @@
 
 use std::process::ExitCode;
 
-use raylane::vectors::{self, Case, Digest, LANE_WIDTHS, Method, Outcome, Tally};
+use raylane_lab::vectors::{self, Case, Digest, LANE_WIDTHS, Method, Outcome, Tally};
 
 fn main() -> ExitCode {
     let dir = std::env::args()

@@ -1,7 +1,7 @@
 //! The operation-count report: every kernel's multiplies, additions (subtractions included),
 //! divisions, square roots and compares per lane per test, on a miss and on a hit, measured by
 //! running the kernels with the op-counting lane `Counted<f32>` (see `raylane::opcount`), then
-//! the study table of every published method beside raylane's own (`raylane::study`): counts,
+//! the study table of every published method beside raylane's own (`raylane_lab::study`): counts,
 //! bytes and precomputation per primitive, accuracy per input class, and watertightness.
 //!
 //! ```text
@@ -26,11 +26,11 @@ mod watertight;
 mod study;
 
 /// Every study method on both paths (and its precomputation, if any), each one out-of-line
-/// call of `raylane::study::repeat` over 64 iterations and one over none, in 8 lanes, each
+/// call of `raylane_lab::study::repeat` over 64 iterations and one over none, in 8 lanes, each
 /// call announced by a `cfg SHAPE METHOD PATH UNITS N` line (`UNITS` tests or builds per
 /// iteration; under callgrind, dump k is call k).
 fn measure() {
-    use raylane::study::{self, METHODS, PATHS, Path, Shape};
+    use raylane_lab::study::{self, METHODS, PATHS, Path, Shape};
     use std::io::Write;
     let mut out = std::io::stdout().lock();
     for (i, (shape, method)) in METHODS.iter().enumerate() {
@@ -65,7 +65,7 @@ fn main() {
     let csv = std::env::args().any(|a| a == "--csv");
     let write = std::env::args().any(|a| a == "--write");
     let mut out = String::new();
-    raylane::opcount::write_report(&mut out, &raylane::opcount::table(), csv)
+    raylane_lab::opcount::write_report(&mut out, &raylane_lab::opcount::table(), csv)
         .expect("a String accepts any text");
     print!("{out}");
     if csv {

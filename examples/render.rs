@@ -12,7 +12,7 @@
 //!   --threads N        worker threads (default: every core)
 //!   --ppm FILE         write one scene as a binary PPM instead (the firmware comparison)
 //!   --scene bunny-fw   (not among the six) the firmware `bvh`'s picture: the vendored bunny's
-//!                      primary rays through the BVH, one thread (`raylane::demo::bunny`)
+//!                      primary rays through the BVH, one thread (`raylane_lab::demo::bunny`)
 //! ```
 //!
 //! 1. `1-precision.png`: the precision lecture's unit sphere 100 units (top row) and 4100 units
@@ -47,14 +47,14 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use raylane::Lane;
-use raylane::demo::{
+use raylane::plane::FocalPlane;
+use raylane::sphere::FocalSphere;
+use raylane::triangle::FocalTriangle;
+use raylane_lab::demo::{
     self, Frame, Part, Scene, Stats, Storage, Tile,
     scenes::{self, Ground, Mix, Precision},
 };
-use raylane::plane::FocalPlane;
-use raylane::registry::Kernel;
-use raylane::sphere::FocalSphere;
-use raylane::triangle::FocalTriangle;
+use raylane_lab::registry::Kernel;
 use wide::{f32x4, f32x8, f32x16};
 
 #[path = "render/bvh.rs"]
@@ -657,10 +657,10 @@ fn mesh(o: &Options) -> (&'static str, Picture, usize) {
 
 /// Scene 4: spheres, meshes and a plane.
 /// The firmware `bvh`'s picture (`targets/src/bin/bvh.rs`): the vendored bunny's BVH built by
-/// `raylane::demo::bunny`'s code on one thread, primary rays only.
+/// `raylane_lab::demo::bunny`'s code on one thread, primary rays only.
 fn bunny_fw(o: &Options) -> (&'static str, Picture, usize) {
     use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
-    use raylane::demo::bunny;
+    use raylane_lab::demo::bunny;
     let (w, h) = o.size.unwrap_or(bunny::SIZE);
     let start = Instant::now();
     let mut tris = vec![raylane::triangle::Triangle::never(); bunny::TRIANGLES];

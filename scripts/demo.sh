@@ -5,7 +5,7 @@
 #   ./scripts/demo.sh
 set -euo pipefail
 cd "$(dirname "$0")/.."
-cargo build --quiet --release --features vectors --example check --example opcount
+cargo build --quiet --release --example check --example opcount
 for method in quadratic geometric robust focal plane cramer moller watertight; do
   printf '\n== %s (cases outside its documented limits are counted, not compared)\n' "$method"
   ./target/release/examples/check --method "$method" tests/vectors/*.txt

@@ -62,32 +62,30 @@ rustup toolchain list | grep -q "^$msrv-" \
 step "format and lints"
 cargo fmt --all -- --check
 (cd targets && cargo fmt -- --check)
-cargo clippy --quiet --workspace --all-targets --features raylane/vectors,raylane/demo -- -D warnings
-RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps --features vectors,demo
+cargo clippy --quiet --workspace --all-targets -- -D warnings
+RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p raylane -p raylane-lab
 
-step "library builds: host, AArch64 and every embedded target; no default features, each feature"
+step "library builds: host, AArch64 and every embedded target; the lab beside it"
 for t in x86_64-unknown-linux-gnu aarch64-unknown-linux-gnu "${embedded[@]}"; do
-  for f in "" vectors demo vectors,demo; do
-    cargo build --quiet --lib --target "$t" --no-default-features ${f:+--features "$f"} \
-      --target-dir target/matrix || fail "the library does not build for $t with features [$f]"
-  done
-  echo "$t: builds with no default features, vectors, demo, vectors+demo"
+  cargo build --quiet --lib --target "$t" --no-default-features --target-dir target/matrix \
+    || fail "the library does not build for $t"
+  cargo build --quiet --lib --target "$t" -p raylane-lab --target-dir target/matrix \
+    || fail "the lab does not build for $t"
+  echo "$t: the library (no default features) and the lab build"
 done
 
 step "MSRV: the library built and tested with Rust $msrv"
-for f in "" vectors demo; do
-  cargo "+$msrv" build --quiet --lib --no-default-features ${f:+--features "$f"} --target-dir target/msrv
-done
-cargo "+$msrv" test --quiet -p raylane --features vectors,demo --target-dir target/msrv \
+cargo "+$msrv" build --quiet --lib --no-default-features --target-dir target/msrv
+cargo "+$msrv" test --quiet -p raylane --target-dir target/msrv \
   > target/msrv.log 2>&1 || { cat target/msrv.log; fail "the tests fail with Rust $msrv"; }
 grep -E '^test result' target/msrv.log | sed "s/^/rust $msrv: /"
 echo "rust $msrv ($(rustc "+$msrv" --version)): the library builds with every feature and its tests pass"
 
 step "host test suite (x86-64)"
-cargo test --quiet --features vectors,demo
+cargo test --quiet
 
 step "checker: every method, every lane width"
-cargo build --quiet --release --features vectors,demo --example check --example digest --example render
+cargo build --quiet --release --example check --example digest --example render
 for method in $(./target/release/examples/check --list); do
   for lanes in 1 4 8 16; do
     printf '%-16s x%-3s' "$method" "$lanes"
@@ -127,8 +125,8 @@ same() { # same NAME FILE [BASE]: FILE's digests equal BASE's (default: x86-64's
 
 for cpu in x86-64-v3 native; do
   step "host test suite, -C target-cpu=$cpu"
-  RUSTFLAGS="-C target-cpu=$cpu" cargo test --quiet --features vectors,demo --target-dir "target/cpu-$cpu"
-  RUSTFLAGS="-C target-cpu=$cpu" cargo build --quiet --release --features vectors,demo --example digest \
+  RUSTFLAGS="-C target-cpu=$cpu" cargo test --quiet --target-dir "target/cpu-$cpu"
+  RUSTFLAGS="-C target-cpu=$cpu" cargo build --quiet --release --example digest \
     --target-dir "target/cpu-$cpu"
   timed "$cpu" "target/cpu-$cpu/release/examples/digest" > "target/digests/$cpu.log"
   grep '^digest' "target/digests/$cpu.log" > "target/digests/$cpu.txt"
@@ -136,8 +134,8 @@ for cpu in x86-64-v3 native; do
 done
 
 step "AArch64 (NEON) test suite under qemu-aarch64"
-cargo test --quiet --release --features vectors,demo --target aarch64-unknown-linux-gnu
-cargo build --quiet --release --features vectors,demo --example digest --target aarch64-unknown-linux-gnu
+cargo test --quiet --release --target aarch64-unknown-linux-gnu
+cargo build --quiet --release --example digest --target aarch64-unknown-linux-gnu
 timed aarch64 qemu-aarch64 -L /usr/aarch64-linux-gnu \
   target/aarch64-unknown-linux-gnu/release/examples/digest > target/digests/aarch64.log
 grep '^digest' target/digests/aarch64.log > target/digests/aarch64.txt

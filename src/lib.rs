@@ -31,13 +31,10 @@
 //! [`lane`] (the abstraction), [`vec3`] (`V3<L>`, SoA vectors), [`ray`] (rays and packets),
 //! [`camera`] (pinhole primary rays from one focal point), [`sphere`], [`plane`], [`triangle`],
 //! [`mesh`] (triangles over shared vertex slices), [`bounds`] (bounding spheres and culling),
-//! [`query`] (the one way to ask: [`Query`], [`Hit`], [`Hits`]), [`registry`] (the one list of kernels that the
-//! checker, the demo, the benchmarks, the firmware and the op-count report walk), [`opcount`]
-//! (the counting lane), and, behind the `vectors` feature, `vectors` (the test-vector parser,
-//! runner and digest shared by the checker, the tests and the firmware) and behind the `demo`
-//! feature `demo` (the scenes and their renderer). `ARCHITECTURE.md` draws the layers. The
-//! per-set loops and lane-wise records below the queries are raylane's own (its benches,
-//! firmware and tests reach them through a hidden `internals` module, outside semver).
+//! [`bvh`] (the bounding volume hierarchy and its instances), [`query`] (the one way to ask:
+//! [`Query`], [`Hit`], [`Hits`]) and [`opcount`] (the counting lane). `ARCHITECTURE.md` draws
+//! the layers. The kernel registry, the test-vector runner, the op-count report and study and
+//! the demo scenes live in the workspace's `lab` crate, beside the library.
 //!
 //! ## Example
 //!
@@ -58,8 +55,6 @@
 pub mod bounds;
 pub mod bvh;
 pub mod camera;
-#[cfg(feature = "demo")]
-pub mod demo;
 #[doc(hidden)]
 pub mod hit;
 #[doc(hidden)]
@@ -70,13 +65,9 @@ pub mod opcount;
 pub mod plane;
 pub mod query;
 pub mod ray;
-pub mod registry;
 pub mod sphere;
-pub mod study;
 pub mod triangle;
 pub mod vec3;
-#[cfg(feature = "vectors")]
-pub mod vectors;
 
 /// The README's examples, compiled and run as doctests.
 #[cfg(doctest)]

@@ -222,10 +222,10 @@ impl<'a> Mesh<'a> {
     /// The closest hit's loop state with kernel `K`, or `None` when the bounding sphere
     /// excludes every valid lane (then no triangle was tested): for the demo, which counts
     /// what culling saves.
-    #[cfg(feature = "demo")]
+    #[doc(hidden)]
     #[inline]
     #[must_use]
-    pub(crate) fn try_closest<K: TriangleKernel, L: Lane>(
+    pub fn try_closest<K: TriangleKernel, L: Lane>(
         &self,
         rays: &RayPacket<L>,
         cull: Cull,
@@ -386,9 +386,10 @@ impl<'c> FocalMesh<'c> {
     /// The closest hit's loop state for prepared rays from the eye, or `None` when the bounding
     /// sphere excludes every valid lane (then no triangle was tested): for the demo, which
     /// counts what culling saves.
+    #[doc(hidden)]
     #[inline]
     #[must_use]
-    pub(crate) fn try_closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Option<Best<L>> {
+    pub fn try_closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Option<Best<L>> {
         self.kept(rays)
             .map(|r| tf::closest_prepared(&r, self.cache, cull))
     }

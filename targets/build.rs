@@ -2,7 +2,7 @@
 //! parsed here by raylane's own parser into a compact binary form (see `raylane_fw::Cases`).
 use std::{env, fmt::Write as _, fs, path::PathBuf};
 
-use raylane::vectors::{self, Case, Kind};
+use raylane_lab::vectors::{self, Case, Kind};
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").unwrap());

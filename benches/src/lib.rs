@@ -316,7 +316,7 @@ impl<L: Lane> Lanes<L> {
     }
 }
 
-pub use raylane::registry::{Kernel, Prim};
+pub use raylane_lab::registry::{Kernel, Prim};
 
 /// What the benchmarks need to know about a kernel of the registry, beyond its metadata.
 pub trait BenchKernel {
@@ -414,7 +414,7 @@ pub trait WithKernel<L: Lane> {
     ) -> Self::Output;
 }
 
-/// The [`raylane::registry::Visitor`] that binds a kernel's queries over a frame and its lanes
+/// The [`raylane_lab::registry::Visitor`] that binds a kernel's queries over a frame and its lanes
 /// and hands them to a [`WithKernel`].
 struct Queries<'a, L: Lane, B> {
     frame: &'a Frame,
@@ -422,7 +422,7 @@ struct Queries<'a, L: Lane, B> {
     body: B,
 }
 
-impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane::registry::Visitor for Queries<'_, L, B> {
+impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane_lab::registry::Visitor for Queries<'_, L, B> {
     type Output = B::Output;
 
     fn sphere<K: SphereKernel>(self, _: Kernel) -> B::Output {

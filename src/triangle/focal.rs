@@ -374,7 +374,8 @@ impl<L: Lane> FocalTriangle<L> {
 /// lanes (1 ray × N triangles), or a [`Splat`] of one entry (N rays × 1 triangle) that
 /// broadcasts only what each step needs, so a miss reads the edge normals and bounds alone and
 /// the exact fallback reads the scalar entry (no splatted copy of the whole entry is built).
-pub(crate) trait FocalTriangleLanes<L: Lane> {
+#[doc(hidden)]
+pub trait FocalTriangleLanes<L: Lane> {
     /// `n_ab`, `n_bc`, `n_ca` in lanes.
     fn normals(&self) -> (V3<L>, V3<L>, V3<L>);
     /// `k_ab`, `k_bc`, `k_ca` in lanes.
@@ -567,7 +568,8 @@ impl<L: Lane> FocalRays<L> {
     /// The scaled rays (the kernel's units).
     #[inline]
     #[must_use]
-    pub(crate) fn scaled(&self) -> &RayPacket<L> {
+    #[doc(hidden)]
+    pub fn scaled(&self) -> &RayPacket<L> {
         &self.scaled
     }
 
@@ -620,7 +622,8 @@ fn own_units<L: Lane>(t: L, s: L) -> L {
 /// [module docs](self).
 #[inline(always)]
 #[must_use]
-pub(crate) fn kernel<L: Lane, F: FocalTriangleLanes<L>>(
+#[doc(hidden)]
+pub fn kernel<L: Lane, F: FocalTriangleLanes<L>>(
     ray: &RayPacket<L>,
     f: &F,
     cull: Cull,

@@ -16,14 +16,14 @@ use raylane::internals;
 use raylane::internals::Best;
 use raylane::mesh::Mesh;
 use raylane::plane::{FocalPlane, Plane};
-use raylane::registry::{Kernel, Visitor};
 use raylane::sphere::focal::{Focal, FocalKernel};
 use raylane::sphere::{FocalSphere, Robust, Sphere, SphereKernel, SpherePacket};
 use raylane::triangle::{
     self, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket, Watertight,
 };
-use raylane::vectors::{Case, Kind, Values};
 use raylane::{Lane, Mask, Query, Ray, RayPacket};
+use raylane_lab::registry::{Kernel, Visitor};
+use raylane_lab::vectors::{Case, Kind, Values};
 
 // The critical-section implementations the semihosting crates need (single core / hart).
 #[cfg(target_arch = "arm")]

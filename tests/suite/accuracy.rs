@@ -1,6 +1,6 @@
 //! Every method's accuracy against the exact answers, per class of input, pinned.
 //!
-//! The measurement is `raylane::vectors::accuracy` (one place): over the generated vector file
+//! The measurement is `raylane_lab::vectors::accuracy` (one place): over the generated vector file
 //! of each class, the largest relative `t` error and absolute `u`, `v` error of every method
 //! against the exact answers, and the same over each case's recorded conditioning. The figures
 //! are deterministic and bit-identical at every lane width and on every target (the digests
@@ -9,8 +9,8 @@
 //! `cargo run --release --features vectors --example accuracy -- --write` rewrites the pin
 //! (`tests/suite/accuracy_pinned.md`) and the README's tables between its `accuracy` markers.
 
-use raylane::vectors::accuracy::{self, Class, Errors};
-use raylane::vectors::{Case, Method, Outcome};
+use raylane_lab::vectors::accuracy::{self, Class, Errors};
+use raylane_lab::vectors::{Case, Method, Outcome};
 
 fn text(c: &Class) -> &'static str {
     crate::vectors::FILES
@@ -91,7 +91,7 @@ fn readme_accuracy_tables_are_the_report() {
 /// get hit/miss wrong on far spheres; `cramer` and `moller` lose `t` on needles.
 #[test]
 fn kernel_table_claims_hold() {
-    use raylane::vectors::Kind;
+    use raylane_lab::vectors::Kind;
     let worst = |m: Method, kind: Kind, f: fn(&Errors) -> f64| {
         accuracy::CLASSES
             .iter()
@@ -132,7 +132,7 @@ fn kernel_table_claims_hold() {
 /// of the inputs changes `t` by less than 2^-18 (relative) its `t` is within 2^-16.
 #[test]
 fn focal_triangles_as_accurate_as_moller() {
-    use raylane::vectors::{self, Kind};
+    use raylane_lab::vectors::{self, Kind};
     let mut bad = Vec::new();
     for c in accuracy::CLASSES
         .iter()

@@ -4,7 +4,6 @@
 use glam::Vec3;
 use raylane::internals;
 use raylane::plane::{FocalPlane, Plane};
-use raylane::registry::{Kernel, Prim, Visitor};
 use raylane::sphere::focal::Focal;
 use raylane::sphere::focal::FocalKernel;
 use raylane::sphere::{
@@ -12,6 +11,7 @@ use raylane::sphere::{
 };
 use raylane::triangle::TriangleKernel;
 use raylane::{Lane, Ray, RayPacket};
+use raylane_lab::registry::{Kernel, Prim, Visitor};
 use wide::f32x8;
 
 const NAN: f32 = f32::NAN;

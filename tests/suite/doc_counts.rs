@@ -1,12 +1,13 @@
 //! Docs that cannot drift: every operation count a doc comment quotes as a marker
 //! `` `ops KERNEL/PATH: 4 mul, 2 add, 1 cmp` `` (omitted kinds are zero) equals the pinned
-//! report's row (`raylane::opcount::table`), and every kernel of the registry quotes its miss
-//! and its hit that way (in `src/registry.rs`, beside its row).
+//! report's row (`raylane_lab::opcount::table`), and every kernel of the registry quotes its miss
+//! and its hit that way (in `lab/src/registry.rs`, beside its row).
 
 use std::path::Path;
 
-use raylane::opcount::{OpCounts, table};
-use raylane::registry::Kernel;
+use raylane::opcount::OpCounts;
+use raylane_lab::opcount::table;
+use raylane_lab::registry::Kernel;
 
 /// One marker: where it is, the row it names and the counts it quotes.
 #[derive(Debug)]
@@ -86,9 +87,10 @@ fn markers(dir: &Path, out: &mut Vec<Marker>) {
 
 #[test]
 fn doc_op_counts_equal_the_pinned_table() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut found = Vec::new();
-    markers(&root, &mut found);
+    markers(&root.join("src"), &mut found);
+    markers(&root.join("lab/src"), &mut found);
     let rows = table();
     let mut wrong = Vec::new();
     for m in &found {

@@ -1,7 +1,6 @@
 //! The host test suite, as one test binary (every kernel is monomorphised once for all tests,
 //! which keeps builds quick for each CPU configuration and for the AArch64 run).
 
-#[cfg(feature = "vectors")]
 mod accuracy;
 mod bad_input;
 mod bunny;
@@ -17,14 +16,10 @@ mod lanes;
 mod opcount;
 mod query;
 mod readme;
-#[cfg(feature = "demo")]
 mod render;
 mod robust;
-#[cfg(feature = "vectors")]
 mod study;
 mod triangles;
-#[cfg(feature = "vectors")]
 mod vectors;
 mod watertight;
-#[cfg(feature = "demo")]
 mod watertight_range;

@@ -1,6 +1,7 @@
 //! The operation counts are measured by the counting lane, and pinned here.
 
-use raylane::opcount::{OpCounts, table};
+use raylane::opcount::OpCounts;
+use raylane_lab::opcount::table;
 
 fn get(kernel: &str, path: &str) -> OpCounts {
     table()
@@ -111,14 +112,14 @@ fn a_panicking_measurement_releases_the_lock() {
 
 #[test]
 fn published_methods_counts_are_pinned() {
-    use raylane::study::{Precompute, entries};
-    let get = |m: &str, shape: raylane::study::Shape| {
+    use raylane_lab::study::{Precompute, entries};
+    let get = |m: &str, shape: raylane_lab::study::Shape| {
         entries()
             .into_iter()
             .find(|e| e.method == m && e.shape == shape)
             .unwrap_or_else(|| panic!("no study entry {m}"))
     };
-    let tri = raylane::study::Shape::Triangle;
+    let tri = raylane_lab::study::Shape::Triangle;
     // (method, miss, hit, behind, precomputation)
     let want = [
         (
@@ -173,7 +174,7 @@ fn published_methods_counts_are_pinned() {
         };
         assert_eq!(got, pre, "{m} precomputation");
     }
-    let ball = raylane::study::Shape::Sphere;
+    let ball = raylane_lab::study::Shape::Sphere;
     let pbrt = get("pbrt", ball);
     assert_eq!(
         (pbrt.miss, pbrt.hit),
@@ -202,10 +203,10 @@ fn published_methods_counts_are_pinned() {
 
 #[test]
 fn every_registry_kernel_is_in_the_report() {
-    use raylane::registry::Kernel;
+    use raylane_lab::registry::Kernel;
     let t = table();
     assert!(
-        t.len() < raylane::opcount::MAX_ROWS,
+        t.len() < raylane_lab::opcount::MAX_ROWS,
         "the report may be truncated"
     );
     for k in Kernel::ALL {

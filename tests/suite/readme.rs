@@ -14,7 +14,7 @@ fn readme_op_count_table_is_the_report() {
         .expect("README has the opcount:end marker")
         + start;
     let mut want = String::new();
-    raylane::opcount::write_report(&mut want, &raylane::opcount::table(), false).unwrap();
+    raylane_lab::opcount::write_report(&mut want, &raylane_lab::opcount::table(), false).unwrap();
     assert_eq!(
         &readme[start..stop],
         want,

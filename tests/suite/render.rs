@@ -13,16 +13,16 @@
 //! Run with `--nocapture` to see the counts and digests.
 
 use glam::Vec3;
-use raylane::demo::{
+use raylane::plane::FocalPlane;
+use raylane::sphere::FocalSphere;
+use raylane::triangle::{Cull, FocalTriangle};
+use raylane::{Lane, RayPacket, V3};
+use raylane_lab::demo::{
     self, Camera, Frame, ID_NONE, ID_SPHERE, ID_TRIANGLE, Part, Scene, Storage,
     scenes::{self, Ground, Mix, Precision},
     shapes,
 };
-use raylane::plane::FocalPlane;
-use raylane::registry::Kernel;
-use raylane::sphere::FocalSphere;
-use raylane::triangle::{Cull, FocalTriangle};
-use raylane::{Lane, RayPacket, V3};
+use raylane_lab::registry::Kernel;
 use wide::{f32x4, f32x8, f32x16};
 
 /// Caches for one frame.
@@ -422,14 +422,14 @@ fn frames_refuse_short_storage_and_render_into_short_buffers() {
     assert_eq!(demo::ppm_header(64, 48, &mut head[..5]), None);
 }
 
-/// The firmware `bvh`'s picture (`raylane::demo::bunny`, `targets/src/bin/bvh.rs`): the vendored
+/// The firmware `bvh`'s picture (`raylane_lab::demo::bunny`, `targets/src/bin/bvh.rs`): the vendored
 /// bunny loads, its BVH builds in `bvh::needed` storage, and the 64×48 render gives the same
 /// bytes at every lane width, pinned by the digest the Cortex-M4F and M33 print.
 #[test]
 fn bunny_fw_render_is_pinned_at_every_width() {
     use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
-    use raylane::demo::bunny;
     use raylane::triangle::Triangle;
+    use raylane_lab::demo::bunny;
     let bin = include_bytes!("../data/bunny.bin");
     let mut tris = vec![Triangle::never(); bunny::TRIANGLES];
     assert_eq!(bunny::load(bin, &mut tris), Some(bunny::TRIANGLES));

@@ -1,12 +1,12 @@
 //! The operation-count study's table (issue 13): the library's counts
-//! ([`raylane::study::entries`]) with each method's accuracy per input class (from the vector
-//! files, by [`raylane::vectors::accuracy`]) and its leaks and double hits on the closed meshes
+//! ([`raylane_lab::study::entries`]) with each method's accuracy per input class (from the vector
+//! files, by [`raylane_lab::vectors::accuracy`]) and its leaks and double hits on the closed meshes
 //! of the watertight harness. `examples/opcount.rs` includes this file to print the table;
 //! the test pins the README's copy.
 
-use raylane::study::{self, Entry, Insns, Measured, Shape};
-use raylane::vectors::accuracy::{self, CLASSES};
-use raylane::vectors::{Case, Kind, Method, Outcome};
+use raylane_lab::study::{self, Entry, Insns, Measured, Shape};
+use raylane_lab::vectors::accuracy::{self, CLASSES};
+use raylane_lab::vectors::{Case, Kind, Method, Outcome};
 
 use crate::watertight;
 
@@ -131,7 +131,7 @@ fn the_timed_methods_are_the_entries() {
 
 #[test]
 fn the_timed_loops_hit_and_miss_as_announced() {
-    use raylane::study::{METHODS, Path, Precompute, entries, precomputes, repeat, units};
+    use raylane_lab::study::{METHODS, Path, Precompute, entries, precomputes, repeat, units};
     use wide::f32x8;
     let entries = entries();
     for (i, m) in METHODS.iter().enumerate() {

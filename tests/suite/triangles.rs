@@ -9,14 +9,12 @@ use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
-use raylane::demo::shapes;
 use raylane::internals;
 use raylane::internals::Best;
 use raylane::internals::{FocalRays, HitRecord, LaneHit};
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
-use raylane::opcount::{OpCounts, table};
-use raylane::registry::{Kernel, Prim, Visitor};
+use raylane::opcount::OpCounts;
 use raylane::sphere::SphereKernel;
 use raylane::sphere::focal::FocalKernel;
 use raylane::triangle::{
@@ -24,6 +22,9 @@ use raylane::triangle::{
     PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
 };
 use raylane::{Hits, Query, Ray, RayPacket};
+use raylane_lab::demo::shapes;
+use raylane_lab::opcount::table;
+use raylane_lab::registry::{Kernel, Prim, Visitor};
 use std::marker::PhantomData;
 use wide::{f32x4, f32x8, f32x16};
 

@@ -1,7 +1,7 @@
 //! The shared test vectors, on the host: every method at every lane width passes every case
 //! inside its documented limits, and every width returns the same bits (equal digests).
 
-use raylane::vectors::{self, Case, Digest, Kind, Method, Outcome, Verdict};
+use raylane_lab::vectors::{self, Case, Digest, Kind, Method, Outcome, Verdict};
 
 /// Every vector file: (stem, text).
 pub(crate) const FILES: &[(&str, &str)] = &[

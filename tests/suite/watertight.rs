@@ -15,13 +15,13 @@ use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::V3;
-use raylane::demo::shapes;
 use raylane::mesh::Mesh;
-use raylane::registry::{Kernel, Prim, Visitor};
 use raylane::sphere::SphereKernel;
 use raylane::sphere::focal::FocalKernel;
 use raylane::triangle::{FocalTriangle, TriangleKernel};
 use raylane::{Ray, RayPacket};
+use raylane_lab::demo::shapes;
+use raylane_lab::registry::{Kernel, Prim, Visitor};
 
 pub(crate) struct Shape {
     name: &'static str,

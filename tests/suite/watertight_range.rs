@@ -6,9 +6,9 @@
 
 use glam::Vec3;
 use raylane::Ray;
-use raylane::demo::shapes;
 use raylane::mesh::Mesh;
 use raylane::triangle::{Cramer, Moller, TriangleKernel, Watertight};
+use raylane_lab::demo::shapes;
 
 /// The demo's icosphere of frequency 3 about an off-axis centre, radius 2, vertices snapped to
 /// multiples of 2^-12 (shared vertices stay shared: the mesh is still closed).

@@ -1,7 +1,7 @@
 //! Builds the BVH of the vendored Stanford bunny (`tests/data/bunny.bin`, 3,674 triangles,
 //! embedded) on the device, in stack storage sized by `bvh::needed`, renders its primary rays
 //! at 64×48 through the tree with the scalar `f32` lane and with packets of 4, 8 and 16 rays
-//! (`wide`'s array fallback) — the same `raylane::demo::bunny` code, camera and shading as
+//! (`wide`'s array fallback) — the same `raylane_lab::demo::bunny` code, camera and shading as
 //! the host's `render --scene bunny-fw` — checks that every width gives the same bytes, and
 //! writes the image to the host as a binary PPM through semihosting file I/O, to
 //! `target/bvh.ppm` in this crate's directory. `scripts/test.sh` compares it byte for byte with
@@ -45,12 +45,12 @@ mod device {
 #[cfg(not(scalar_only))]
 mod device {
     use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
-    use raylane::demo::{self, bunny};
     use raylane::triangle::Triangle;
     use raylane::wide::{f32x4, f32x8, f32x16};
     use raylane::{Lane, Pinhole};
     use raylane_fw::exit;
     use raylane_fw::semihosting::{hprintln, nr, syscall};
+    use raylane_lab::demo::{self, bunny};
 
     const W: u32 = bunny::SIZE.0;
     const H: u32 = bunny::SIZE.1;

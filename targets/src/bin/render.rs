@@ -1,5 +1,5 @@
 //! Renders the demo's scene 4 (spheres, an icosahedron, a cube and a checkered plane) at
-//! 64×48 with the scalar `f32` lane — the same `raylane::demo` code, scene and camera as the
+//! 64×48 with the scalar `f32` lane — the same `raylane_lab::demo` code, scene and camera as the
 //! host's `render` example — and writes it to the host as a binary PPM through semihosting
 //! file I/O, to `target/render.ppm` in this crate's directory (an absolute path fixed at build
 //! time; the directory exists once the crate is built). `scripts/test.sh` compares the file
@@ -11,11 +11,11 @@
 #![no_std]
 #![no_main]
 
-use raylane::demo::{self, Frame, Storage, scenes::Mix};
-use raylane::registry::Kernel;
 use raylane::triangle::FocalTriangle;
 use raylane_fw::semihosting::{hprintln, nr, syscall};
 use raylane_fw::{entry, exit};
+use raylane_lab::demo::{self, Frame, Storage, scenes::Mix};
+use raylane_lab::registry::Kernel;
 
 raylane_fw::panic_exits!();
 

@@ -1,8 +1,8 @@
 //! Executed instructions per ray–primitive test of every method of raylane's operation-count
-//! study (`raylane::study`), counted by QEMU's TCG plugin `targets/plugin/insncount.c`: run
+//! study (`raylane_lab::study`), counted by QEMU's TCG plugin `targets/plugin/insncount.c`: run
 //! `scripts/count-study.sh` (it builds this, runs it on mps2-an386 and stores the counts).
 //!
-//! Each method's timed loop ([`raylane::study::repeat`], scalar `f32` lanes) runs between
+//! Each method's timed loop ([`raylane_lab::study::repeat`], scalar `f32` lanes) runs between
 //! [`study_begin`] and [`study_end`] once over 64 iterations and once over none, on the miss,
 //! on the hit and on the precomputation (if any); the plugin prints one window per run.
 //! Output (semihosting): one `cfg SHAPE METHOD PATH UNITS N` line per window, in window order.
@@ -11,9 +11,9 @@
 
 use core::hint::black_box;
 
-use raylane::study::{METHODS, PATHS, Path, Shape, precomputes, repeat, units};
 use raylane_fw::semihosting::hprintln;
 use raylane_fw::{entry, exit};
+use raylane_lab::study::{METHODS, PATHS, Path, Shape, precomputes, repeat, units};
 
 raylane_fw::panic_exits!();
 

@@ -18,10 +18,10 @@
 #![no_std]
 #![no_main]
 
-#[cfg(not(scalar_only))]
-use raylane::vectors::LANE_WIDTHS;
-use raylane::vectors::{self, Case, Digest, Method, Outcome, Tally};
 use raylane_fw::{entry, exit, semihosting::hprintln};
+#[cfg(not(scalar_only))]
+use raylane_lab::vectors::LANE_WIDTHS;
+use raylane_lab::vectors::{self, Case, Digest, Method, Outcome, Tally};
 
 raylane_fw::panic_exits!();
 
@@ -120,7 +120,7 @@ fn main() -> ! {
 /// 16 KB of RAM).
 #[inline(never)]
 fn opcounts() {
-    for r in raylane::opcount::table().iter() {
+    for r in raylane_lab::opcount::table().iter() {
         let c = r.counts;
         hprintln!(
             "opcount {},{},{},{},{},{},{}",

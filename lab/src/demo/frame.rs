@@ -3,11 +3,11 @@
 use glam::Vec3;
 
 use super::{Camera, MAX_PARTS, Paint, Scene};
-use crate::mesh::{FocalMesh, Mesh};
-use crate::plane::{FocalPlane, Plane};
 use crate::registry::{Family, Kernel, Prim};
-use crate::sphere::{FocalSphere, Sphere};
-use crate::triangle::{Cull, FocalTriangle};
+use raylane::mesh::{FocalMesh, Mesh};
+use raylane::plane::{FocalPlane, Plane};
+use raylane::sphere::{FocalSphere, Sphere};
+use raylane::triangle::{Cull, FocalTriangle};
 
 /// Caller storage for a frame's focal caches. Pinhole frames need one sphere entry per sphere
 /// (focal methods only), one plane entry per plane and one triangle entry per triangle of every

@@ -2,13 +2,13 @@
 
 use glam::Vec3;
 
-use crate::camera::Pinhole;
-use crate::lane::{Lane, sqrt_f32};
-use crate::plane::Plane;
-use crate::ray::RayPacket;
-use crate::sphere::Sphere;
-use crate::triangle::Cull;
-use crate::vec3::V3;
+use raylane::camera::Pinhole;
+use raylane::lane::{Lane, sqrt_f32};
+use raylane::plane::Plane;
+use raylane::ray::RayPacket;
+use raylane::sphere::Sphere;
+use raylane::triangle::Cull;
+use raylane::vec3::V3;
 
 /// How a surface is coloured (linear RGB in `[0, 1]`, lit by the scene's light).
 #[derive(Clone, Copy, Debug, PartialEq)]

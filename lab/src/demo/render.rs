@@ -2,16 +2,16 @@
 
 use super::empty_sphere;
 use super::{Camera, Frame, ID_NONE, ID_PLANE, ID_SPHERE, ID_TRIANGLE, Stats, Tile};
-use crate::hit;
-use crate::lane::{Lane, MAX_LANES, Mask};
-use crate::mesh::Mesh;
-use crate::plane;
-use crate::ray::RayPacket;
 use crate::registry::{Kernel, Visitor};
-use crate::sphere::focal::{self as sf, FocalKernel};
-use crate::sphere::{self, FocalSphere, Sphere, SphereKernel};
-use crate::triangle::focal::FocalRays;
-use crate::triangle::{Cull, TriangleKernel, Watertight};
+use raylane::hit;
+use raylane::lane::{Lane, MAX_LANES, Mask};
+use raylane::mesh::Mesh;
+use raylane::plane;
+use raylane::ray::RayPacket;
+use raylane::sphere::focal::{self as sf, FocalKernel};
+use raylane::sphere::{self, FocalSphere, Sphere, SphereKernel};
+use raylane::triangle::focal::FocalRays;
+use raylane::triangle::{Cull, TriangleKernel, Watertight};
 
 /// What is hit in each lane of a packet, merged over the kinds of primitive.
 #[derive(Clone, Copy, Debug)]
@@ -126,7 +126,7 @@ impl Frame<'_> {
     /// its own out-of-line function: smaller functions, much quicker to compile for every lane
     /// width.)
     fn trace<L: Lane<Scalar = f32>>(&self, rays: &RayPacket<L>, stats: &mut Stats) -> Best {
-        crate::lane::assert_fits::<L>();
+        raylane::lane::assert_fits::<L>();
         let k = count(rays);
         stats.rays += k;
         let mut best = Best::new();
@@ -194,7 +194,7 @@ impl Frame<'_> {
         guarded: bool,
     ) -> hit::Best<L> {
         let mut best = hit::Best::<L>::miss();
-        crate::lane::assert_fits::<L>();
+        raylane::lane::assert_fits::<L>();
         let mut entries = [empty_sphere(); MAX_LANES];
         for (j, s) in self.scene.spheres.iter().enumerate() {
             for (i, e) in entries.iter_mut().enumerate().take(L::LANES) {

@@ -11,13 +11,13 @@
 //!
 //! Every vertex shared by several triangles is stored once and referenced by index, and every
 //! triangle is wound counter-clockwise seen from outside (`(B − A) × (C − A)` points out), so
-//! back-face culling ([`Cull::Back`](crate::triangle::Cull)) keeps the outside. Positions are
+//! back-face culling ([`Cull::Back`](raylane::triangle::Cull)) keeps the outside. Positions are
 //! computed in `f64` with correctly rounded operations only (`libm::sqrt` included), then
 //! rounded once to `f32`: the same bits on every target.
 
 use glam::Vec3;
 
-use crate::vec3::V3;
+use raylane::vec3::V3;
 
 /// Exact-input `f64` vectors (the crate's `V3` over the `f64` lane).
 type D3 = V3<f64>;

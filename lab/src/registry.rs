@@ -20,7 +20,7 @@
 //!   family runs every kernel of it at full speed (no dynamic dispatch in the kernel).
 //!
 //! ```
-//! use raylane::registry::{Kernel, Method, Prim};
+//! use raylane_lab::registry::{Kernel, Method, Prim};
 //!
 //! assert_eq!(Kernel::from_name("watertight"), Some(Kernel::Watertight));
 //! assert_eq!(Method::Focal.kernel(Prim::Triangle), Some(Kernel::TriangleFocal));
@@ -28,9 +28,9 @@
 //! assert!(Kernel::ALL.iter().all(|k| Kernel::from_name(k.name()) == Some(*k)));
 //! ```
 
-use crate::sphere::SphereKernel;
-use crate::sphere::focal::FocalKernel;
-use crate::triangle::{PrecomputedKernel, TriangleKernel};
+use raylane::sphere::SphereKernel;
+use raylane::sphere::focal::FocalKernel;
+use raylane::triangle::{PrecomputedKernel, TriangleKernel};
 
 /// What a kernel intersects.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -74,8 +74,8 @@ pub enum Family {
     /// A [`SphereKernel`] over spheres ([`Visitor::sphere`]).
     Sphere,
     /// A [`FocalKernel`] over sphere focal caches ([`Visitor::focal_sphere`]), built by
-    /// [`FocalSphere::new`](crate::sphere::FocalSphere::new) (`guarded`) or
-    /// [`FocalSphere::unguarded`](crate::sphere::FocalSphere::unguarded).
+    /// [`FocalSphere::new`](raylane::sphere::FocalSphere::new) (`guarded`) or
+    /// [`FocalSphere::unguarded`](raylane::sphere::FocalSphere::unguarded).
     FocalSphere {
         /// Which cache the kernel reads.
         guarded: bool,
@@ -121,8 +121,8 @@ pub trait Visitor {
     /// A sphere kernel `K` over spheres.
     fn sphere<K: SphereKernel>(self, k: Kernel) -> Self::Output;
     /// A focal kernel `K` over sphere focal caches; `guarded` says which cache it reads
-    /// ([`FocalSphere::new`](crate::sphere::FocalSphere::new) or
-    /// [`FocalSphere::unguarded`](crate::sphere::FocalSphere::unguarded)).
+    /// ([`FocalSphere::new`](raylane::sphere::FocalSphere::new) or
+    /// [`FocalSphere::unguarded`](raylane::sphere::FocalSphere::unguarded)).
     fn focal_sphere<K: FocalKernel>(self, k: Kernel, guarded: bool) -> Self::Output;
     /// The ray–plane test over planes.
     fn plane(self, k: Kernel) -> Self::Output;
@@ -355,171 +355,171 @@ impl Kernel {
 // methods precompute on the fly there) as `ops` markers, which `tests/suite/doc_counts.rs`
 // checks against the table.
 registry! {
-    /// [`Quadratic`](crate::sphere::Quadratic): the general quadratic.
+    /// [`Quadratic`](raylane::sphere::Quadratic): the general quadratic.
     Quadratic "quadratic" {
-        /// [`sphere::Quadratic`](crate::sphere::Quadratic).
+        /// [`sphere::Quadratic`](raylane::sphere::Quadratic).
         ///
         /// Per lane: `ops quadratic/miss: 12 mul, 11 add, 1 cmp`;
         /// `ops quadratic/hit: 12 mul, 13 add, 2 div, 1 sqrt, 10 cmp`.
-        Quadratic "quadratic", unit: false, error: Textbook, sphere(crate::sphere::Quadratic);
+        Quadratic "quadratic", unit: false, error: Textbook, sphere(raylane::sphere::Quadratic);
     }
-    /// [`QuadraticUnit`](crate::sphere::QuadraticUnit): the quadratic with `a = 1`.
+    /// [`QuadraticUnit`](raylane::sphere::QuadraticUnit): the quadratic with `a = 1`.
     QuadraticUnit "quadratic-unit" {
-        /// [`sphere::QuadraticUnit`](crate::sphere::QuadraticUnit).
+        /// [`sphere::QuadraticUnit`](raylane::sphere::QuadraticUnit).
         ///
         /// Per lane: `ops quadratic-unit/miss: 8 mul, 9 add, 1 cmp`;
         /// `ops quadratic-unit/hit: 8 mul, 11 add, 1 sqrt, 8 cmp`.
         QuadraticUnit "quadratic-unit", unit: true, error: Textbook,
-            sphere(crate::sphere::QuadraticUnit);
+            sphere(raylane::sphere::QuadraticUnit);
     }
-    /// [`Geometric`](crate::sphere::Geometric): the lecture's geometric test.
+    /// [`Geometric`](raylane::sphere::Geometric): the lecture's geometric test.
     Geometric "geometric" {
-        /// [`sphere::Geometric`](crate::sphere::Geometric).
+        /// [`sphere::Geometric`](raylane::sphere::Geometric).
         ///
         /// Per lane: `ops geometric/miss: 8 mul, 8 add, 1 cmp`;
         /// `ops geometric/hit: 8 mul, 11 add, 1 sqrt, 8 cmp`.
-        Geometric "geometric", unit: true, error: Textbook, sphere(crate::sphere::Geometric);
+        Geometric "geometric", unit: true, error: Textbook, sphere(raylane::sphere::Geometric);
     }
-    /// [`Robust`](crate::sphere::Robust): Ray Tracing Gems ch. 7.
+    /// [`Robust`](raylane::sphere::Robust): Ray Tracing Gems ch. 7.
     Robust "robust" {
-        /// [`sphere::Robust`](crate::sphere::Robust).
+        /// [`sphere::Robust`](raylane::sphere::Robust).
         ///
         /// Per lane: `ops robust/miss: 14 mul, 13 add, 1 div, 1 cmp`;
         /// `ops robust/hit: 17 mul, 17 add, 3 div, 1 sqrt, 12 cmp`.
-        Robust "robust", unit: false, error: RobustSphere, sphere(crate::sphere::Robust);
+        Robust "robust", unit: false, error: RobustSphere, sphere(raylane::sphere::Robust);
     }
     /// The focal caches of spheres (guarded), planes and triangles; per vector case the eye is
     /// the ray origin.
     Focal "focal" {
-        /// [`sphere::focal::Focal`](crate::sphere::focal::Focal) over guarded caches.
+        /// [`sphere::focal::Focal`](raylane::sphere::focal::Focal) over guarded caches.
         ///
         /// Per lane: `ops focal/miss: 4 mul, 2 add, 1 cmp`;
         /// `ops focal/hit: 10 mul, 10 add, 1 sqrt, 9 cmp`.
         Focal "focal", unit: true, error: Exact,
-            focal_sphere(crate::sphere::focal::Focal, true);
-        /// [`FocalPlane`](crate::plane::FocalPlane) caches.
+            focal_sphere(raylane::sphere::focal::Focal, true);
+        /// [`FocalPlane`](raylane::plane::FocalPlane) caches.
         ///
         /// Per lane: `ops plane-focal/miss: 3 mul, 2 add, 1 div, 2 cmp`;
         /// `ops plane-focal/hit: 3 mul, 2 add, 1 div, 2 cmp`.
         PlaneFocal "plane-focal", unit: false, error: Exact, focal_plane;
-        /// [`FocalTriangle`](crate::triangle::FocalTriangle) caches.
+        /// [`FocalTriangle`](raylane::triangle::FocalTriangle) caches.
         ///
         /// Per lane: `ops triangle-focal/miss: 9 mul, 6 add, 6 cmp`;
         /// `ops triangle-focal/hit: 13 mul, 10 add, 1 div, 15 cmp`.
         TriangleFocal "triangle-focal", unit: false, error: Exact, focal_triangle;
     }
-    /// [`FocalUnguarded`](crate::sphere::focal::FocalUnguarded): the lecture's unguarded focal
+    /// [`FocalUnguarded`](raylane::sphere::focal::FocalUnguarded): the lecture's unguarded focal
     /// test.
     FocalUnguarded "focal-unguarded" {
-        /// [`sphere::focal::FocalUnguarded`](crate::sphere::focal::FocalUnguarded) over
+        /// [`sphere::focal::FocalUnguarded`](raylane::sphere::focal::FocalUnguarded) over
         /// unguarded caches.
         ///
         /// Per lane: `ops focal-unguarded/miss: 4 mul, 2 add, 1 cmp`;
         /// `ops focal-unguarded/hit: 4 mul, 5 add, 1 sqrt, 5 cmp`.
         FocalUnguarded "focal-unguarded", unit: true, error: Textbook,
-            focal_sphere(crate::sphere::focal::FocalUnguarded, false);
+            focal_sphere(raylane::sphere::focal::FocalUnguarded, false);
     }
     /// The ray–plane test.
     Plane "plane" {
-        /// [`plane::intersect_lanes`](crate::plane::intersect_lanes).
+        /// [`plane::intersect_lanes`](raylane::plane::intersect_lanes).
         ///
         /// Per lane: `ops plane/miss: 6 mul, 7 add, 1 div, 2 cmp`;
         /// `ops plane/hit: 6 mul, 7 add, 1 div, 2 cmp`.
         Plane "plane", unit: false, error: Exact, plane;
     }
-    /// [`Cramer`](crate::triangle::Cramer): lecture 002.
+    /// [`Cramer`](raylane::triangle::Cramer): lecture 002.
     Cramer "cramer" {
-        /// [`triangle::Cramer`](crate::triangle::Cramer).
+        /// [`triangle::Cramer`](raylane::triangle::Cramer).
         ///
         /// Per lane: `ops cramer/miss: 21 mul, 22 add, 2 div, 5 cmp`;
         /// `ops cramer/hit: 30 mul, 27 add, 3 div, 7 cmp`.
-        Cramer "cramer", unit: false, error: Needle, triangle(crate::triangle::Cramer);
+        Cramer "cramer", unit: false, error: Needle, triangle(raylane::triangle::Cramer);
     }
-    /// [`Moller`](crate::triangle::Moller): Möller–Trumbore, division deferred.
+    /// [`Moller`](raylane::triangle::Moller): Möller–Trumbore, division deferred.
     Moller "moller" {
-        /// [`triangle::Moller`](crate::triangle::Moller).
+        /// [`triangle::Moller`](raylane::triangle::Moller).
         ///
         /// Per lane: `ops moller/miss: 21 mul, 22 add, 5 cmp`;
         /// `ops moller/hit: 25 mul, 24 add, 1 div, 12 cmp`.
-        Moller "moller", unit: false, error: Needle, triangle(crate::triangle::Moller);
+        Moller "moller", unit: false, error: Needle, triangle(raylane::triangle::Moller);
     }
-    /// [`Watertight`](crate::triangle::Watertight): Woop, Benthin, Wald 2013.
+    /// [`Watertight`](raylane::triangle::Watertight): Woop, Benthin, Wald 2013.
     Watertight "watertight" {
-        /// [`triangle::Watertight`](crate::triangle::Watertight).
+        /// [`triangle::Watertight`](raylane::triangle::Watertight).
         ///
         /// Per lane: `ops watertight/miss: 12 mul, 18 add, 6 cmp`;
         /// `ops watertight/hit: 19 mul, 22 add, 1 div, 15 cmp`.
-        Watertight "watertight", unit: false, error: Exact, triangle(crate::triangle::Watertight);
+        Watertight "watertight", unit: false, error: Exact, triangle(raylane::triangle::Watertight);
     }
-    /// [`Pbrt`](crate::sphere::Pbrt): pbrt-v4's sphere test, without intervals.
+    /// [`Pbrt`](raylane::sphere::Pbrt): pbrt-v4's sphere test, without intervals.
     Pbrt "pbrt" {
-        /// [`sphere::Pbrt`](crate::sphere::Pbrt).
+        /// [`sphere::Pbrt`](raylane::sphere::Pbrt).
         ///
         /// Per lane: `ops pbrt/miss: 21 mul, 17 add, 1 div, 1 sqrt, 1 cmp`;
         /// `ops pbrt/hit: 22 mul, 18 add, 3 div, 2 sqrt, 7 cmp`.
-        Pbrt "pbrt", unit: false, error: RobustSphere, sphere(crate::sphere::Pbrt);
+        Pbrt "pbrt", unit: false, error: RobustSphere, sphere(raylane::sphere::Pbrt);
     }
-    /// [`EmbreeSphere`](crate::sphere::EmbreeSphere): Embree's sphere test.
+    /// [`EmbreeSphere`](raylane::sphere::EmbreeSphere): Embree's sphere test.
     EmbreeSphere "embree" {
-        /// [`sphere::EmbreeSphere`](crate::sphere::EmbreeSphere).
+        /// [`sphere::EmbreeSphere`](raylane::sphere::EmbreeSphere).
         ///
         /// Per lane: `ops embree/miss: 14 mul, 12 add, 1 div, 1 cmp`;
         /// `ops embree/hit: 15 mul, 15 add, 1 div, 1 sqrt, 5 cmp`.
         EmbreeSphere "embree", unit: false, error: RobustSphere,
-            sphere(crate::sphere::EmbreeSphere);
+            sphere(raylane::sphere::EmbreeSphere);
     }
-    /// [`Badouel`](crate::triangle::Badouel): Badouel 1990, plane then a 2-D test.
+    /// [`Badouel`](raylane::triangle::Badouel): Badouel 1990, plane then a 2-D test.
     Badouel "badouel" {
-        /// [`triangle::Badouel`](crate::triangle::Badouel).
+        /// [`triangle::Badouel`](raylane::triangle::Badouel).
         ///
         /// Per lane: `ops badouel/miss: 23 mul, 28 add, 3 div, 9 cmp`;
         /// `ops badouel/hit: 23 mul, 28 add, 3 div, 9 cmp`.
-        Badouel "badouel", unit: false, error: Record, precomputed(crate::triangle::Badouel);
+        Badouel "badouel", unit: false, error: Record, precomputed(raylane::triangle::Badouel);
     }
-    /// [`Plucker`](crate::triangle::Plucker): Plücker edge tests (Segura–Feito 1998, as in
+    /// [`Plucker`](raylane::triangle::Plucker): Plücker edge tests (Segura–Feito 1998, as in
     /// Embree).
     Plucker "plucker" {
-        /// [`triangle::Plucker`](crate::triangle::Plucker).
+        /// [`triangle::Plucker`](raylane::triangle::Plucker).
         ///
         /// Per lane: `ops plucker/miss: 28 mul, 44 add, 6 cmp`;
         /// `ops plucker/hit: 41 mul, 53 add, 1 div, 20 cmp`.
-        Plucker "plucker", unit: false, error: Needle, triangle(crate::triangle::Plucker);
+        Plucker "plucker", unit: false, error: Needle, triangle(raylane::triangle::Plucker);
     }
-    /// [`Wald`](crate::triangle::Wald): Wald 2004, precomputed projection.
+    /// [`Wald`](raylane::triangle::Wald): Wald 2004, precomputed projection.
     Wald "wald" {
-        /// [`triangle::Wald`](crate::triangle::Wald).
+        /// [`triangle::Wald`](raylane::triangle::Wald).
         ///
         /// Per lane: `ops wald/miss: 31 mul, 25 add, 2 div, 9 cmp`;
         /// `ops wald/hit: 31 mul, 25 add, 2 div, 9 cmp`.
-        Wald "wald", unit: false, error: Record, precomputed(crate::triangle::Wald);
+        Wald "wald", unit: false, error: Record, precomputed(raylane::triangle::Wald);
     }
-    /// [`HavelHerout`](crate::triangle::HavelHerout): Havel–Herout 2010, precomputed planes.
+    /// [`HavelHerout`](raylane::triangle::HavelHerout): Havel–Herout 2010, precomputed planes.
     HavelHerout "havel-herout" {
-        /// [`triangle::HavelHerout`](crate::triangle::HavelHerout).
+        /// [`triangle::HavelHerout`](raylane::triangle::HavelHerout).
         ///
         /// Per lane: `ops havel-herout/miss: 56 mul, 39 add, 1 div, 5 cmp`;
         /// `ops havel-herout/hit: 57 mul, 39 add, 2 div, 12 cmp`.
         HavelHerout "havel-herout", unit: false, error: Record,
-            precomputed(crate::triangle::HavelHerout);
+            precomputed(raylane::triangle::HavelHerout);
     }
-    /// [`KenslerShirley`](crate::triangle::KenslerShirley): Kensler–Shirley 2006.
+    /// [`KenslerShirley`](raylane::triangle::KenslerShirley): Kensler–Shirley 2006.
     KenslerShirley "kensler-shirley" {
-        /// [`triangle::KenslerShirley`](crate::triangle::KenslerShirley).
+        /// [`triangle::KenslerShirley`](raylane::triangle::KenslerShirley).
         ///
         /// Per lane: `ops kensler-shirley/miss: 23 mul, 22 add, 1 div, 3 cmp`;
         /// `ops kensler-shirley/hit: 27 mul, 24 add, 1 div, 5 cmp`.
         KenslerShirley "kensler-shirley", unit: false, error: Needle,
-            triangle(crate::triangle::KenslerShirley);
+            triangle(raylane::triangle::KenslerShirley);
     }
-    /// [`BaldwinWeber`](crate::triangle::BaldwinWeber): Baldwin–Weber 2016, precomputed affine
+    /// [`BaldwinWeber`](raylane::triangle::BaldwinWeber): Baldwin–Weber 2016, precomputed affine
     /// transform.
     BaldwinWeber "baldwin-weber" {
-        /// [`triangle::BaldwinWeber`](crate::triangle::BaldwinWeber).
+        /// [`triangle::BaldwinWeber`](raylane::triangle::BaldwinWeber).
         ///
         /// Per lane: `ops baldwin-weber/miss: 37 mul, 30 add, 2 div, 8 cmp`;
         /// `ops baldwin-weber/hit: 37 mul, 30 add, 2 div, 8 cmp`.
         BaldwinWeber "baldwin-weber", unit: false, error: Record,
-            precomputed(crate::triangle::BaldwinWeber);
+            precomputed(raylane::triangle::BaldwinWeber);
     }
 }
 

@@ -17,7 +17,7 @@
 //! kernels ([`sphere_kernels`]), the focal caches or `quadratic`, `geometric`, `robust`,
 //! `pbrt`, `embree` over the same packets. A [`Camera::Ortho`] makes parallel rays with
 //! different origins (the precision lecture's orthographic camera): there the non-focal
-//! kernels run per packet ([`Watertight`](crate::triangle::Watertight) for triangles), and
+//! kernels run per packet ([`Watertight`](raylane::triangle::Watertight) for triangles), and
 //! [`Kernel::Focal`] builds a focal
 //! cache *per ray*, with the ray's own origin as the eye, gathered into lanes — which shows
 //! what the guard decides, not how fast the cache is.
@@ -25,7 +25,7 @@
 //! **Closest hit.** Spheres, then planes, then each mesh part; a kind's hit replaces the best
 //! so far only where its `t` is strictly smaller (ties keep the earlier kind and index), and
 //! each kind sees the rays' `t_max` relaxed to the best so far (`t + |t|·2^-21`, as in
-//! [`hit`](crate::hit)).
+//! [`hit`](raylane::hit)).
 //!
 //! **Shading** uses `+ − × ÷ √` and compares only (no transcendental functions, whose library
 //! implementations may differ between targets): Lambert's law under one directional light with
@@ -46,11 +46,11 @@
 //! BVH, the picture the firmware `bvh` and the host's `render --scene bunny-fw` share
 //! ([`bunny`]).
 //!
-//! [`Pinhole::row_packet`]: crate::camera::Pinhole::row_packet
-//! [`FocalSphere`]: crate::sphere::FocalSphere
-//! [`FocalPlane`]: crate::plane::FocalPlane
-//! [`FocalMesh`]: crate::mesh::FocalMesh
-//! [`Mesh::bounded`]: crate::mesh::Mesh::bounded
+//! [`Pinhole::row_packet`]: raylane::camera::Pinhole::row_packet
+//! [`FocalSphere`]: raylane::sphere::FocalSphere
+//! [`FocalPlane`]: raylane::plane::FocalPlane
+//! [`FocalMesh`]: raylane::mesh::FocalMesh
+//! [`Mesh::bounded`]: raylane::mesh::Mesh::bounded
 
 pub mod bunny;
 mod frame;

@@ -1,7 +1,7 @@
 //! The operation-count study: every ray–triangle and ray–sphere method, published or
 //! raylane's own, measured by the same counting lane (issue 13).
 //!
-//! [`entries`] measures each method with [`Counted<f32>`](crate::opcount::Counted) on the same
+//! [`entries`] measures each method with [`Counted<f32>`](raylane::opcount::Counted) on the same
 //! worked examples as the op-count report ([`opcount::table`](crate::opcount::table), whose
 //! rows it reuses for raylane's own kernels): a **miss** (triangles: beyond edge BC, every
 //! method's latest exit; spheres: the lecture's miss ray), a **hit**, and for triangles a
@@ -25,16 +25,17 @@ use core::mem::size_of;
 
 use glam::Vec3;
 
-use crate::lane::{Lane, Mask};
-use crate::opcount::{Counted, OpCounts, measure, table};
-use crate::ray::{Ray, RayPacket};
-use crate::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
-use crate::sphere::{
+use crate::opcount::table;
+use raylane::lane::{Lane, Mask};
+use raylane::opcount::{Counted, OpCounts, measure};
+use raylane::ray::{Ray, RayPacket};
+use raylane::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
+use raylane::sphere::{
     self, EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust,
     SphereKernel, SpherePacket,
 };
-use crate::triangle::focal::FocalRays;
-use crate::triangle::{
+use raylane::triangle::focal::FocalRays;
+use raylane::triangle::{
     Badouel, BaldwinWeber, Cramer, Cull, FocalTriangle, HavelHerout, KenslerShirley, Moller,
     Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
     focal as tf,
@@ -519,7 +520,7 @@ pub fn repeat<L: Lane<Scalar = f32>>(index: usize, path: Path, n: usize) -> Opti
             let ray = triangle_rays()[usize::from(hit)];
             let rp = black_box(RayPacket::<L>::splat(&ray));
             let tp = TrianglePacket::<L>::splat(&triangle());
-            let lane_hits = |h: &crate::hit::LaneHit<L>| h.mask.bits().count_ones();
+            let lane_hits = |h: &raylane::hit::LaneHit<L>| h.mask.bits().count_ones();
             fn plain<K: TriangleKernel, L: Lane<Scalar = f32>>(
                 n: usize,
                 rp: &RayPacket<L>,

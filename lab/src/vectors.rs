@@ -28,16 +28,16 @@ use core::hash::Hasher as _;
 
 use glam::Vec3;
 
-use crate::hit::LaneHit;
-use crate::lane::{Lane, MAX_LANES, Mask};
-use crate::plane::{self, FocalPlane, Plane, PlanePacket};
-use crate::ray::RayPacket;
 use crate::registry::{Kernel, Visitor};
-use crate::sphere::focal::FocalKernel;
-use crate::sphere::{FocalSphere, Roots, Sphere, SphereKernel, SpherePacket};
-use crate::triangle::focal::FocalRays;
-use crate::triangle::{self, Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
-use crate::vec3::V3;
+use raylane::hit::LaneHit;
+use raylane::lane::{Lane, MAX_LANES, Mask};
+use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
+use raylane::ray::RayPacket;
+use raylane::sphere::focal::FocalKernel;
+use raylane::sphere::{FocalSphere, Roots, Sphere, SphereKernel, SpherePacket};
+use raylane::triangle::focal::FocalRays;
+use raylane::triangle::{self, Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
+use raylane::vec3::V3;
 
 /// Relative tolerance on `t`.
 pub const T_TOLERANCE: f64 = 2e-5;
@@ -328,7 +328,7 @@ mod limits {
 
     use super::{Case, Kind, Limit, Method, T_TOLERANCE};
     use crate::registry::ErrorModel;
-    use crate::vec3::V3;
+    use raylane::vec3::V3;
 
     const U: f64 = 1.0 / 16_777_216.0;
 
@@ -550,7 +550,7 @@ fn run<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome
 /// Evaluates up to `L::LANES` cases of one kind in one packet: the method's kernel for the
 /// kind, through the [registry](crate::registry).
 fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome]) {
-    crate::lane::assert_fits::<L>();
+    raylane::lane::assert_fits::<L>();
     match method.kernel(cases[0].kind) {
         Some(k) => k.visit(Batch::<L>::new(cases, out)),
         None => out.iter_mut().for_each(|o| *o = Outcome::default()),

@@ -1,5 +1,5 @@
 //! The vendored Stanford bunny (`tests/data/bunny.bin`, 3,674 triangles) through the BVH
-//! ([`crate::bvh`]): loading, camera and a primary-ray render shared by the host's `render`
+//! ([`raylane::bvh`]): loading, camera and a primary-ray render shared by the host's `render`
 //! example (`--scene bunny-fw`) and the firmware `targets/src/bin/bvh.rs`, which compares the
 //! two byte for byte at every packet width (`scripts/test.sh`).
 //!
@@ -10,11 +10,11 @@
 use glam::Vec3;
 
 use super::shade::to_rgb;
-use crate::bvh::TriangleBvh;
-use crate::camera::Pinhole;
-use crate::lane::Lane;
-use crate::query::Query;
-use crate::triangle::Triangle;
+use raylane::bvh::TriangleBvh;
+use raylane::camera::Pinhole;
+use raylane::lane::Lane;
+use raylane::query::Query;
+use raylane::triangle::Triangle;
 
 /// Triangles of the vendored bunny.
 pub const TRIANGLES: usize = 3674;

@@ -6,8 +6,8 @@ use glam::Vec3;
 use super::render::Best;
 use super::scene::unit;
 use super::{Frame, ID_PLANE, ID_SPHERE, ID_TRIANGLE, Paint};
-use crate::lane::sqrt_f32;
-use crate::vec3::V3;
+use raylane::lane::sqrt_f32;
+use raylane::vec3::V3;
 
 impl Frame<'_> {
     /// The colour of lane `i` (origin `o`, direction `d`), as RGB8.

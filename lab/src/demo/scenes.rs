@@ -21,11 +21,11 @@ use glam::Vec3;
 use super::scene::unit;
 use super::shapes;
 use super::{Camera, Ortho, Paint, Part, Scene};
-use crate::camera::Pinhole;
-use crate::plane::Plane;
 use crate::registry::Kernel;
-use crate::sphere::Sphere;
-use crate::triangle::Cull;
+use raylane::camera::Pinhole;
+use raylane::plane::Plane;
+use raylane::sphere::Sphere;
+use raylane::triangle::Cull;
 
 /// Direction towards the light of the lit scenes (unit length up to rounding).
 pub const LIGHT: Vec3 = Vec3::new(-0.48, 0.8, 0.36);
