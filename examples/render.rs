@@ -633,7 +633,7 @@ fn mesh(o: &Options) -> (&'static str, Picture, usize) {
         first: 0,
         count: 0,
         paint: demo::Paint::Normal,
-        cull: raylane::triangle::Cull::Back,
+        cull: raylane::Cull::Back,
     }; scenes::ICOSPHERE_PARTS];
     let scene = scenes::icosphere(n, &mut positions, &mut indices, &mut parts)
         .expect("storage sized for the icosphere");
@@ -667,11 +667,11 @@ fn bunny_fw(o: &Options) -> (&'static str, Picture, usize) {
     let n = bunny::load(include_bytes!("../tests/data/bunny.bin"), &mut tris)
         .expect("tests/data/bunny.bin is well formed");
     tris.truncate(n);
-    let need = bvh::needed(n);
+    let need = bvh::TriangleBvh::needed(n);
     let mut nodes = vec![Node::EMPTY; need.nodes];
     let mut leaves = vec![<Tri4 as Packed>::EMPTY; need.leaves];
     let mut scratch = vec![Scratch::default(); need.scratch];
-    let tree = bvh::build(&tris[..], &mut nodes[..], &mut leaves[..], &mut scratch[..])
+    let tree = bvh::Bvh::build(&tris[..], &mut nodes[..], &mut leaves[..], &mut scratch[..])
         .expect("storage sized by bvh::needed");
     let cam = bunny::camera(&tris, w, h);
     let mut rgb = vec![0u8; 3 * w as usize * h as usize];

@@ -1,449 +1,654 @@
-//! Hit records and the loops shared by every primitive: closest hit, any hit.
+//! Hits and collectors: what a query returns ([`Hit`], [`Hits`]), and the one place where
+//! kernel answers become query answers ([`Collector`]: [`Closest`], [`Any`], [`All`]).
 //!
-//! A kernel tests ray lanes against primitive lanes and reports a [`LaneHit`]: the parameter
-//! `t`, two surface parameters `u`, `v` (barycentrics for triangles, zero otherwise) and the
-//! lanes that hit. The loops here run a kernel over a slice of primitives:
+//! Every set of the crate — flat slices, meshes, focal caches, BVHs and their instances —
+//! runs its kernels and hands each answer to a collector, which alone decides what counts:
 //!
-//! * **N rays × 1 primitive** (`closest`, `any`): the primitive is splatted into every lane
-//!   and the rays' `t_max` shrinks as hits are found, so later primitives must be closer;
-//! * **1 ray × N primitives** (`closest_soa`, `any_soa`): primitives sit in lanes (structure
-//!   of arrays), the ray is splatted, and the lanes are reduced at the end.
+//! * **The interval.** A hit counts when its rounded `t` lies in the ray's open interval
+//!   `(t_min, t_max)`. Kernels are asked with `t_max` relaxed ([`relax`]), so that the
+//!   test some of them make before dividing (`num < t_max·den`, rounded) can never drop such a
+//!   hit, and the collector checks the rounded `t < t_max` itself. `closest`, `any` and `all`
+//!   therefore agree for every `t_max`, finite or not.
+//! * **The tie rule.** The closest hit is the smallest `(t, set, index)`: the smallest rounded
+//!   `t`, ties to the lower set (the position in a tuple, the instance of a scene), then the
+//!   lower primitive index. It does not depend on the order the primitives are visited in, so
+//!   brute force, a BVH and every packet width return the same hit, bit for bit.
+//! * **Shrinking.** After a hit at `t`, kernels are asked with `t_max` relaxed from `t`
+//!   (`t + (|t| + 2^-100)·2^-21`, strictly above `t` even at `t = 0`), so ties at `t` still
+//!   reach the collector and everything farther is cut.
+//! * **Stopping.** [`Any`] stops a traversal once every lane has hit; [`All`] reports every
+//!   hit, in the order the set visits them.
 //!
-//! Both shapes return the same hit, bit for bit, whatever the order the primitives are visited
-//! in: a candidate is taken only when its rounded `t` is strictly below the best so far (ties
-//! go to the lowest primitive index), and after each hit the rays' `t_max` is relaxed to
-//! `t + |t|·2^-21` rather than set to `t`. A kernel may then reject `t ≥ t_max` before its
-//! division as `num < t_max·den` (one multiply, rounded): the relaxation makes that test
-//! conservative, so no would-be winner is dropped and the division runs only for the hits that
-//! win so far.
-//!
-//! Kernels with a deferred division report `u`, `v` unscaled with their denominator (see
-//! [`LaneHit::deferred`]); the loops divide once per ray, for the winner, and every record a
-//! caller sees is normalised.
-//!
-//! Misses are canonical: `t = +inf`, `u = v = 0`, index `u32::MAX`. No record ever holds a NaN,
-//! and none holds `−0`: records carry `+0`.
+//! **Records.** The collectors keep only `t`, the barycentrics, the indices and where the
+//! winner sits; the point `o + t·d` (3 mul, 3 add), the unit geometric normal and the face
+//! are computed once per ray, for the winner ([`Record`]), with the same operations in every
+//! lane: every lane of every width equals the scalar path bit for bit. The normal faces the
+//! ray's origin (`d·normal ≤ 0`); [`Hit::front`] says whether that is the primitive's outer
+//! side (spheres: hit from outside; triangles: `d·N < 0` with `N = (B − A) × (C − A)`, i.e.
+//! A, B, C counter-clockwise as seen from the origin; planes: `d·n < 0`). **Misses** are one
+//! word: `None` for a ray, a clear lane in [`Hits::mask`] (with `t = +inf`, zero vectors and
+//! index `u32::MAX`) for a packet. No record holds a NaN or a `−0`.
 
+use glam::Vec3;
+
+use crate::kernel::{Cull, LaneHit, Primitive, plus_zero};
 use crate::lane::{Lane, Mask, Scalar, select_indices};
-use crate::ray::{Ray, RayPacket};
+use crate::plane::Plane;
+use crate::ray::RayPacket;
+use crate::sphere::Sphere;
+use crate::triangle::{Triangle, TrianglePacket};
+use crate::vec3::V3;
 
-/// One lane-wise test result (see the [module docs](self)).
-#[derive(Clone, Copy, Debug)]
-pub struct LaneHit<L: Lane> {
-    /// Ray parameter of the hit; `+inf` where `mask` is clear.
-    pub t: L,
-    /// First surface parameter (barycentric weight of vertex B for triangles).
-    pub u: L,
-    /// Second surface parameter (barycentric weight of vertex C for triangles).
-    pub v: L,
-    /// Lanes that hit inside the ray interval.
-    pub mask: L::Mask,
-    /// Denominator of `u` and `v` while a query runs (1 once normalised).
-    pub(crate) w: L,
+/// One hit of one ray: what a game engine needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    /// Ray parameter: the point is `o + t·d`, `t` in units of `|d|`.
+    pub t: f32,
+    /// `o + t·d` (3 mul, 3 add, rounded as written).
+    pub point: Vec3,
+    /// Unit geometric normal, facing the ray's origin (`d·normal ≤ 0`).
+    pub normal: Vec3,
+    /// True when the ray hits the primitive's front (outer) side; see the
+    /// [module docs](self).
+    pub front: bool,
+    /// Index of the primitive in its set.
+    pub index: u32,
+    /// Which set of a scene: the position in a tuple of sets, the instance of a
+    /// [`Scene`](crate::bvh::Scene); 0 for a plain set.
+    pub set: u32,
+    /// Barycentric weight of vertex B for triangles; 0 otherwise.
+    pub u: f32,
+    /// Barycentric weight of vertex C for triangles; 0 otherwise.
+    pub v: f32,
 }
 
-impl<L: Lane> LaneHit<L> {
+/// The records of a packet query: [`Hit`]'s fields in lanes, and the lanes that hit.
+#[derive(Clone, Copy, Debug)]
+pub struct Hits<L: Lane> {
+    /// Ray parameter; `+inf` where `mask` is clear.
+    pub t: L,
+    /// `o + t·d`; zero where `mask` is clear.
+    pub point: V3<L>,
+    /// Unit geometric normal facing the origin; zero where `mask` is clear.
+    pub normal: V3<L>,
+    /// Lanes that hit a front face.
+    pub front: L::Mask,
+    /// Primitive index in its set; `u32::MAX` where `mask` is clear.
+    pub index: L::Indices,
+    /// Set of a scene; `u32::MAX` where `mask` is clear.
+    pub set: L::Indices,
+    /// Barycentric weight of B (triangles), else 0.
+    pub u: L,
+    /// Barycentric weight of C (triangles), else 0.
+    pub v: L,
+    /// Lanes that hit.
+    pub mask: L::Mask,
+}
+
+/// `2^e` for `-126 ≤ e ≤ 127`.
+const fn pow2(e: i32) -> f32 {
+    f32::from_bits(((127 + e) as u32) << 23)
+}
+
+impl<L: Lane> Hits<L> {
     /// No lane hits.
-    #[inline(always)]
+    #[inline]
     #[must_use]
     pub fn miss() -> Self {
         let zero = L::from_f32(0.0);
-        LaneHit {
+        let z = V3::new(zero, zero, zero);
+        Hits {
             t: L::from_f32(f32::INFINITY),
+            point: z,
+            normal: z,
+            front: Mask::splat(false),
+            index: L::indices(u32::MAX),
+            set: L::indices(u32::MAX),
             u: zero,
             v: zero,
             mask: Mask::splat(false),
-            w: L::from_f32(1.0),
         }
     }
 
-    /// Canonicalises: lanes outside `mask` get `t = +inf`, `u = v = 0`.
-    #[inline(always)]
-    #[must_use]
-    pub fn new(t: L, u: L, v: L, mask: L::Mask) -> Self {
-        Self::deferred(t, u, v, L::from_f32(1.0), mask)
-    }
-
-    /// A hit whose barycentrics are `u/w`, `v/w`: the division is left to the loops, which do
-    /// it once per ray for the winner ([`normalized`](Self::normalized)).
-    #[inline(always)]
-    #[must_use]
-    pub fn deferred(t: L, u: L, v: L, w: L, mask: L::Mask) -> Self {
-        let zero = L::from_f32(0.0);
-        LaneHit {
-            t: L::select(mask, t, L::from_f32(f32::INFINITY)),
-            u: L::select(mask, u, zero),
-            v: L::select(mask, v, zero),
-            mask,
-            w: L::select(mask, w, L::from_f32(1.0)),
-        }
-    }
-
-    /// `u/w`, `v/w` (2 div): the record as callers see it, with `−0` made `+0` in `t`, `u`,
-    /// `v` (`x + 0`).
-    #[inline(always)]
-    #[must_use]
-    pub fn normalized(self) -> Self {
-        LaneHit {
-            t: plus_zero(self.t),
-            u: plus_zero(self.u / self.w),
-            v: plus_zero(self.v / self.w),
-            w: L::from_f32(1.0),
-            ..self
-        }
-    }
-}
-
-impl LaneHit<f32> {
-    /// The scalar record (index 0), or `None` on a miss. `u`, `v` as stored: normalise first
-    /// where they are deferred.
-    #[inline(always)]
-    #[must_use]
-    pub fn record(self) -> Option<HitRecord> {
-        self.mask.then_some(HitRecord {
-            t: self.t,
-            u: self.u,
-            v: self.v,
-            index: 0,
-        })
-    }
-}
-
-/// The closest hit per lane over a set of primitives, with the primitive's index: the state of
-/// the closest-hit loops, finished into [`Hits`](crate::Hits) by the queries.
-#[derive(Clone, Copy, Debug)]
-pub struct Best<L: Lane> {
-    /// Ray parameter; `+inf` where `mask` is clear.
-    pub t: L,
-    /// First surface parameter (barycentric weight of B for triangles).
-    pub u: L,
-    /// Second surface parameter (barycentric weight of C for triangles).
-    pub v: L,
-    /// Index of the primitive hit in each lane (`u32::MAX` where `mask` is clear).
-    pub index: L::Indices,
-    /// Lanes that hit.
-    pub mask: L::Mask,
-    /// Denominator of `u` and `v` while a query runs (1 once finished).
-    pub(crate) w: L,
-}
-
-/// One hit of one ray, as the scalar API reports it.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct HitRecord {
-    /// Ray parameter: the point is `origin + t·dir`.
-    pub t: f32,
-    /// First surface parameter (barycentric weight of B for triangles; 0 otherwise).
-    pub u: f32,
-    /// Second surface parameter (barycentric weight of C for triangles; 0 otherwise).
-    pub v: f32,
-    /// Index of the primitive in the slice that was searched.
-    pub index: u32,
-}
-
-impl<L: Lane> Best<L> {
-    /// No hit in any lane.
+    /// Lane `i` as a record, or `None` when it missed.
     #[inline]
     #[must_use]
-    pub fn miss() -> Self {
-        let m = LaneHit::<L>::miss();
-        Best {
-            t: m.t,
-            u: m.u,
-            v: m.v,
-            index: L::indices(u32::MAX),
-            mask: m.mask,
-            w: m.w,
-        }
-    }
-
-    /// Lane `i` as a scalar record, or `None` when it missed.
-    #[inline]
-    #[must_use]
-    pub fn lane(&self, i: usize) -> Option<HitRecord>
+    pub fn lane(&self, i: usize) -> Option<Hit>
     where
         L: Lane<Scalar = f32>,
     {
-        self.mask.test(i).then(|| HitRecord {
+        self.mask.test(i).then(|| Hit {
             t: self.t.lane(i),
+            point: self.point.lane(i),
+            normal: self.normal.lane(i),
+            front: self.front.test(i),
+            index: self.index.as_ref()[i],
+            set: self.set.as_ref()[i],
             u: self.u.lane(i),
             v: self.v.lane(i),
-            index: self.index.as_ref()[i],
         })
     }
 
-    /// The finished record of one candidate `h` of primitive `index` (for queries that report
-    /// every hit).
-    #[inline(always)]
-    #[must_use]
-    pub(crate) fn single(h: &LaneHit<L>, index: u32) -> Self {
-        let mut b = Self::miss();
-        b.take(h, h.mask, index);
-        b.finish()
-    }
-
-    /// Takes the hits of `h` in the lanes of `take` for primitive `index`.
-    #[inline(always)]
-    pub(crate) fn take(&mut self, h: &LaneHit<L>, take: L::Mask, index: u32) {
-        self.t = L::select(take, h.t, self.t);
-        self.u = L::select(take, h.u, self.u);
-        self.v = L::select(take, h.v, self.v);
-        self.w = L::select(take, h.w, self.w);
-        self.mask = self.mask | take;
-        select_indices::<L>(take, index, &mut self.index);
-    }
-
-    /// Divides the winners' barycentrics by their denominators (once per ray), with `−0`
-    /// made `+0` in `t`, `u`, `v` (`x + 0`).
-    #[inline(always)]
-    pub(crate) fn finish(mut self) -> Self {
-        self.t = plus_zero(self.t);
-        self.u = plus_zero(self.u / self.w);
-        self.v = plus_zero(self.v / self.w);
-        self.w = L::from_f32(1.0);
-        self
-    }
-}
-
-/// `x + 0`: `−0` becomes `+0` (IEEE round-to-nearest), every other value (NaN aside) is
-/// unchanged. Kernels that fold a sign into their numerators (`select(back, −x, x)`) return
-/// `−0` for a zero barycentric on a back face, or for `t = 0`; records carry `+0`, so that
-/// `u == 0.0` and the bits agree whichever side a ray comes from. One add per field, at the
-/// one place records are made (never in a kernel's counted path).
-#[inline(always)]
-fn plus_zero<L: Lane>(x: L) -> L {
-    x + L::from_f32(0.0)
-}
-
-/// Lanes of `h` strictly closer than `best` (ties keep the earlier, lower-index hit).
-#[inline(always)]
-fn closer<L: Lane>(h: &LaneHit<L>, best: &Best<L>) -> L::Mask {
-    h.mask & h.t.lt(best.t)
-}
-
-/// The relaxed upper end after a hit at `t`: `t + |t|·2^-21` (> t after rounding), so that a
-/// kernel's rounded `num < t_max·den` never rejects a hit that rounds below `t`.
-#[inline(always)]
-pub(crate) fn relax<L: Lane>(t: L) -> L {
-    t + t.abs() * L::from_f32(1.0 / 2_097_152.0)
-}
-
-impl Best<f32> {
-    /// The record, or `None` for a miss.
+    /// Writes one ray's record into lane `i` (a miss clears it).
     #[inline]
+    pub fn set_lane(&mut self, i: usize, h: Option<&Hit>) {
+        let s = |x: f32| L::Scalar::from_f32(x);
+        let m = Self::miss();
+        let h = match h {
+            Some(h) => *h,
+            None => Hit {
+                t: f32::INFINITY,
+                point: Vec3::ZERO,
+                normal: Vec3::ZERO,
+                front: false,
+                index: u32::MAX,
+                set: u32::MAX,
+                u: 0.0,
+                v: 0.0,
+            },
+        };
+        let put = |v: V3<L>, p: Vec3| {
+            V3::new(
+                v.x.with_lane(i, s(p.x)),
+                v.y.with_lane(i, s(p.y)),
+                v.z.with_lane(i, s(p.z)),
+            )
+        };
+        let hit = h.t < f32::INFINITY;
+        self.t = self.t.with_lane(i, s(h.t));
+        self.point = put(self.point, h.point);
+        self.normal = put(self.normal, h.normal);
+        self.front = self.front.with_lane(i, h.front);
+        self.u = self.u.with_lane(i, s(h.u));
+        self.v = self.v.with_lane(i, s(h.v));
+        self.mask = self.mask.with_lane(i, hit);
+        if let Some(x) = self.index.as_mut().get_mut(i) {
+            *x = h.index;
+        }
+        if let Some(x) = self.set.as_mut().get_mut(i) {
+            *x = h.set;
+        }
+        let _ = m;
+    }
+}
+
+/// Where a candidate comes from: the set (tuple position or instance), the primitive's index
+/// in it, and where the set keeps the primitive (`loc`: the index for a flat set, the leaf
+/// and lane in a BVH), so that records can be made for the winner alone.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct At {
+    /// The set.
+    pub set: u32,
+    /// The primitive's index in the set.
+    pub index: u32,
+    /// Where the set keeps it.
+    pub loc: u32,
+}
+
+/// The closest hits of a packet once a traversal has finished: `t`, `u`, `v` (divided), where
+/// each lane's winner comes from, and the lanes that hit.
+#[derive(Clone, Copy, Debug)]
+pub struct Winners<L: Lane> {
+    /// Ray parameter; `+inf` where `mask` is clear.
+    pub t: L,
+    /// Barycentric weight of B for triangles; for spheres 1 on an exit root, else 0.
+    pub u: L,
+    /// Barycentric weight of C for triangles; 0 otherwise.
+    pub v: L,
+    /// The winners' indices (`u32::MAX` where `mask` is clear).
+    pub index: L::Indices,
+    /// Their sets.
+    pub set: L::Indices,
+    /// Where their sets keep them.
+    pub loc: L::Indices,
+    /// Lanes that hit.
+    pub mask: L::Mask,
+}
+
+impl<L: Lane> Winners<L> {
+    /// One candidate as a finished record (what [`All`] reports): `h` divided.
+    #[inline(always)]
     #[must_use]
-    pub fn get(&self) -> Option<HitRecord> {
-        self.lane(0)
+    pub fn single(h: &LaneHit<L>, at: At) -> Self {
+        let h = h.normalized();
+        let none = L::indices(u32::MAX);
+        let (mut index, mut set, mut loc) = (none, none, none);
+        select_indices::<L>(h.mask, at.index, &mut index);
+        select_indices::<L>(h.mask, at.set, &mut set);
+        select_indices::<L>(h.mask, at.loc, &mut loc);
+        Winners {
+            t: h.t,
+            u: h.u,
+            v: h.v,
+            index,
+            set,
+            loc,
+            mask: h.mask,
+        }
+    }
+
+    /// Lane `i`'s `loc`, if it hit.
+    #[inline(always)]
+    #[must_use]
+    pub fn loc(&self, i: usize) -> Option<u32> {
+        if self.mask.test(i) {
+            self.loc.as_ref().get(i).copied()
+        } else {
+            None
+        }
     }
 }
 
-/// Closest hit of ray lanes over primitives tested one at a time (N rays × 1 primitive).
-///
-/// `test` sees the rays with `t_max` already shrunk to the closest hit so far, so it reports
-/// only closer hits; it returns `None` when no lane can hit (a kernel's early exit), which lets
-/// the miss path skip the merge with the hit path entirely.
-#[inline]
-pub(crate) fn closest<L: Lane, P>(
-    rays: &RayPacket<L>,
-    prims: impl IntoIterator<Item = P>,
-    mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
-) -> Best<L> {
-    let mut r = *rays;
-    let mut best = Best::miss();
-    for (i, p) in prims.into_iter().enumerate() {
-        // `None`: no lane passed the kernel's first test (nothing to merge on the miss path).
-        if let Some(h) = test(&r, p) {
-            let take = closer(&h, &best);
-            if take.any() {
-                best.take(&h, take, i as u32);
-                r = r.shrink(take, relax(h.t));
-            }
-        }
-    }
-    best.finish()
-}
-
-/// True in lanes where some primitive is hit (occlusion); stops when every valid lane is hit.
-#[inline]
-pub(crate) fn any<L: Lane, P>(
-    rays: &RayPacket<L>,
-    prims: impl IntoIterator<Item = P>,
-    mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
-) -> L::Mask {
-    let valid = rays.valid();
-    let mut hit = L::Mask::splat(false);
-    for p in prims {
-        if let Some(h) = test(rays, p) {
-            hit = hit | h.mask;
-        }
-        if valid.and_not(hit).none() {
-            break;
-        }
-    }
-    hit & valid
-}
-
-/// Bit `j` set when some lane of `rays` may hit `block[j]` (at most 64 primitives). The
-/// primitives go in pairs with one branch per pair, not one per primitive: most pairs hold no
-/// candidate, and the branch is most of the cost of a certain miss.
+/// The relaxed upper end after a hit at `t`: `t + (|t| + 2^-100)·2^-21`, strictly above `t`
+/// for every finite `t` (also `t = 0` and subnormal `t`, where `|t|·2^-21` alone would round
+/// to nothing), and for `|t| ≥ 2^-76` exactly `t + |t|·2^-21`. A kernel's rounded
+/// `num < t_max·den` then never rejects a hit whose rounded `t` is at most `t` (the product's
+/// relative error, `2^-24`, is below the relaxation's `2^-21`; products that round below the
+/// smallest normal skip that test, see [`crate::triangle`]).
 #[inline(always)]
-fn candidates<L: Lane, P>(
-    rays: &RayPacket<L>,
-    block: &[P],
-    candidate: &mut impl FnMut(&RayPacket<L>, &P) -> L::Mask,
-) -> u64 {
-    let mut bits = 0u64;
-    let mut pairs = block.chunks_exact(2);
-    let mut j = 0;
-    for pair in &mut pairs {
-        if let [p0, p1] = pair {
-            let (m0, m1) = (candidate(rays, p0), candidate(rays, p1));
-            if (m0 | m1).any() {
-                bits |= ((m0.any() as u64) << j) | ((m1.any() as u64) << (j + 1));
-            }
-        }
-        j += 2;
-    }
-    for p in pairs.remainder() {
-        if candidate(rays, p).any() {
-            bits |= 1 << j;
-        }
-    }
-    bits
+#[must_use]
+pub fn relax<L: Lane>(t: L) -> L {
+    t + (t.abs() + L::from_f32(pow2(-100))) * L::from_f32(pow2(-21))
 }
 
-/// [`closest`] in two passes per block of 64 primitives: `candidate` (a kernel's cheap first
-/// step, with no calls, so the rays stay in registers) gives the lanes that may hit each
-/// primitive, then `test` runs on the primitives some lane may hit, in order. Same result as
-/// [`closest`] with `test`, provided `test` returns `None` wherever `candidate` has no lane
-/// set and `candidate` does not depend on `t_max`.
-///
-/// One lane takes a single pass ([`closest`]): `test` stops where the first pass would, and
-/// LLVM turns a one-lane first pass into gathers across primitives (4× slower on x86-64).
-#[inline]
-pub(crate) fn closest_filtered<L: Lane, P>(
-    rays: &RayPacket<L>,
-    prims: &[P],
-    mut candidate: impl FnMut(&RayPacket<L>, &P) -> L::Mask,
-    mut test: impl FnMut(&RayPacket<L>, &P) -> Option<LaneHit<L>>,
-) -> Best<L> {
-    if L::LANES == 1 {
-        return closest(rays, prims, test);
-    }
-    let mut r = *rays;
-    let mut best = Best::miss();
-    for (b, block) in prims.chunks(64).enumerate() {
-        let mut bits = candidates(&r, block, &mut candidate);
-        while bits != 0 {
-            let j = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            if let Some(h) = block.get(j).and_then(|p| test(&r, p)) {
-                let take = closer(&h, &best);
-                if take.any() {
-                    best.take(&h, take, (b * 64 + j) as u32);
-                    r = r.shrink(take, relax(h.t));
-                }
-            }
-        }
-    }
-    best.finish()
+/// Where a set's kernels send their answers (see the [module docs](self)): [`Closest`],
+/// [`Any`] and [`All`]. A set asks each kernel with [`t_max`](Self::t_max) as the upper end
+/// and passes every lane-wise answer to [`offer`](Self::offer).
+pub trait Collector<L: Lane> {
+    /// True when every hit is wanted (a sphere's exit roots too), not only the first per
+    /// primitive; such a traversal cannot be restarted.
+    const EVERY: bool = false;
+    /// The lanes still looking for hits.
+    fn active(&self) -> L::Mask;
+    /// The upper end each lane's kernel test uses now (relaxed; see [`relax`]).
+    fn t_max(&self) -> L;
+    /// Takes the candidates of `h` (its `mask`'s lanes) of the primitive at `at`;
+    /// `record` makes the records of one candidate (for collectors that report every hit).
+    /// Returns true when the traversal may stop.
+    fn offer(
+        &mut self,
+        h: &LaneHit<L>,
+        at: At,
+        record: impl FnOnce(&Winners<L>) -> Hits<L>,
+    ) -> bool;
 }
 
-/// [`any`] in two passes per block of 64 primitives (one lane: a single pass), as
-/// [`closest_filtered`].
-#[inline]
-pub(crate) fn any_filtered<L: Lane, P>(
-    rays: &RayPacket<L>,
-    prims: &[P],
-    mut candidate: impl FnMut(&RayPacket<L>, &P) -> L::Mask,
-    mut test: impl FnMut(&RayPacket<L>, &P) -> Option<LaneHit<L>>,
-) -> L::Mask {
-    if L::LANES == 1 {
-        return any(rays, prims, test);
-    }
-    let valid = rays.valid();
-    let mut hit = L::Mask::splat(false);
-    for block in prims.chunks(64) {
-        let mut bits = candidates(rays, block, &mut candidate);
-        while bits != 0 {
-            let j = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            if let Some(h) = block.get(j).and_then(|p| test(rays, p)) {
-                hit = hit | h.mask;
-                if valid.and_not(hit).none() {
-                    return hit & valid;
-                }
-            }
-        }
-    }
-    hit & valid
+/// The closest hit per lane: the smallest `(t, set, index)` with `t` inside the interval.
+#[derive(Clone, Copy, Debug)]
+pub struct Closest<L: Lane> {
+    t: L,
+    u: L,
+    v: L,
+    w: L,
+    index: L::Indices,
+    set: L::Indices,
+    loc: L::Indices,
+    mask: L::Mask,
+    valid: L::Mask,
+    /// The rays' own upper ends.
+    t_end: L,
+    /// The kernels' upper ends.
+    t_max: L,
 }
 
-/// Closest hit of one ray over primitives stored `L::LANES` to a chunk (1 ray × N primitives).
-///
-/// `test` gets the ray splatted into lanes (with per-lane shrinking `t_max`) and the chunk
-/// index; primitive `j` of chunk `c` has index `c·L::LANES + j`. Lanes past `count` must miss
-/// (padding), which the primitive packets guarantee.
-#[inline]
-pub(crate) fn closest_soa<L: Lane, P>(
-    ray: &Ray,
-    chunks: impl IntoIterator<Item = P>,
-    mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
-) -> Option<HitRecord>
-where
-    L::Scalar: Scalar,
-{
-    let mut r = RayPacket::<L>::splat(ray);
-    let mut best = Best::<L>::miss();
-    for (c, p) in chunks.into_iter().enumerate() {
-        let Some(h) = test(&r, p) else { continue };
-        let take = closer(&h, &best);
-        if take.any() {
-            let mut bits = take.bits();
+impl<L: Lane> Closest<L> {
+    /// The collector for `rays` (nothing found yet).
+    #[inline(always)]
+    #[must_use]
+    pub fn new(rays: &RayPacket<L>) -> Self {
+        let m = LaneHit::<L>::miss();
+        let valid = rays.valid();
+        let none = L::indices(u32::MAX);
+        Closest {
+            t: m.t,
+            u: m.u,
+            v: m.v,
+            w: m.w,
+            index: none,
+            set: none,
+            loc: none,
+            mask: m.mask,
+            valid,
+            t_end: rays.t_max,
+            t_max: L::select(valid, relax(rays.t_max), rays.t_max),
+        }
+    }
+
+    /// The winners, their barycentrics divided (once per ray), `−0` made `+0`.
+    #[inline(always)]
+    #[must_use]
+    pub fn finish(&self) -> Winners<L> {
+        Winners {
+            t: plus_zero(self.t),
+            u: plus_zero(self.u / self.w),
+            v: plus_zero(self.v / self.w),
+            index: self.index,
+            set: self.set,
+            loc: self.loc,
+            mask: self.mask,
+        }
+    }
+}
+
+impl<L: Lane> Collector<L> for Closest<L> {
+    #[inline(always)]
+    fn active(&self) -> L::Mask {
+        self.valid
+    }
+
+    #[inline(always)]
+    fn t_max(&self) -> L {
+        self.t_max
+    }
+
+    #[inline(always)]
+    fn offer(&mut self, h: &LaneHit<L>, at: At, _: impl FnOnce(&Winners<L>) -> Hits<L>) -> bool {
+        // The interval (the kernel checked t_min), then the tie rule.
+        let inside = h.mask & h.t.lt(self.t_end);
+        let mut take = inside & h.t.lt(self.t);
+        let tie = inside & h.t.le(self.t) & h.t.ge(self.t);
+        if tie.any() {
+            let mut bits = tie.bits();
             while bits != 0 {
                 let j = bits.trailing_zeros() as usize;
-                if let Some(slot) = best.index.as_mut().get_mut(j) {
-                    *slot = (c * L::LANES + j) as u32;
-                }
                 bits &= bits - 1;
+                let (s, i) = (self.set.as_ref()[j], self.index.as_ref()[j]);
+                if (at.set, at.index) < (s, i) {
+                    take = take.with_lane(j, true);
+                }
             }
-            best.t = L::select(take, h.t, best.t);
-            best.u = L::select(take, h.u, best.u);
-            best.v = L::select(take, h.v, best.v);
-            best.w = L::select(take, h.w, best.w);
-            best.mask = best.mask | take;
-            r = r.shrink(take, relax(h.t));
         }
-    }
-    let best = best.finish();
-    // Reduce across lanes: smallest t, ties to the lowest index.
-    let mut out: Option<HitRecord> = None;
-    for j in 0..L::LANES {
-        if !best.mask.test(j) {
-            continue;
+        if take.any() {
+            self.t = L::select(take, h.t, self.t);
+            self.u = L::select(take, h.u, self.u);
+            self.v = L::select(take, h.v, self.v);
+            self.w = L::select(take, h.w, self.w);
+            self.mask = self.mask | take;
+            select_indices::<L>(take, at.index, &mut self.index);
+            select_indices::<L>(take, at.set, &mut self.set);
+            select_indices::<L>(take, at.loc, &mut self.loc);
+            self.t_max = L::select(take, relax(h.t), self.t_max);
         }
-        let rec = HitRecord {
-            t: best.t.lane(j).to_f64() as f32,
-            u: best.u.lane(j).to_f64() as f32,
-            v: best.v.lane(j).to_f64() as f32,
-            index: best.index.as_ref()[j],
-        };
-        out = match out {
-            Some(o) if o.t < rec.t || (o.t == rec.t && o.index < rec.index) => Some(o),
-            _ => Some(rec),
-        };
+        false
     }
-    out
 }
 
-/// True when one ray hits some primitive stored in lanes (1 ray × N primitives).
-#[inline]
-pub(crate) fn any_soa<L: Lane, P>(
-    ray: &Ray,
-    chunks: impl IntoIterator<Item = P>,
-    mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
-) -> bool {
-    let r = RayPacket::<L>::splat(ray);
-    chunks
-        .into_iter()
-        .any(|p| test(&r, p).is_some_and(|h| h.mask.any()))
+/// Whether each lane hits anything inside its interval (occlusion); stops once every lane has.
+#[derive(Clone, Copy, Debug)]
+pub struct Any<L: Lane> {
+    hit: L::Mask,
+    valid: L::Mask,
+    t_end: L,
+    t_max: L,
+}
+
+impl<L: Lane> Any<L> {
+    /// The collector for `rays`.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(rays: &RayPacket<L>) -> Self {
+        let valid = rays.valid();
+        Any {
+            hit: Mask::splat(false),
+            valid,
+            t_end: rays.t_max,
+            t_max: L::select(valid, relax(rays.t_max), rays.t_max),
+        }
+    }
+
+    /// The lanes that hit.
+    #[inline(always)]
+    #[must_use]
+    pub fn finish(&self) -> L::Mask {
+        self.hit & self.valid
+    }
+}
+
+impl<L: Lane> Collector<L> for Any<L> {
+    #[inline(always)]
+    fn active(&self) -> L::Mask {
+        self.valid.and_not(self.hit)
+    }
+
+    #[inline(always)]
+    fn t_max(&self) -> L {
+        self.t_max
+    }
+
+    #[inline(always)]
+    fn offer(&mut self, h: &LaneHit<L>, _: At, _: impl FnOnce(&Winners<L>) -> Hits<L>) -> bool {
+        self.hit = self.hit | (h.mask & h.t.lt(self.t_end) & self.valid);
+        self.valid.and_not(self.hit).none()
+    }
+}
+
+/// Every hit inside the interval, as records passed to a callback in the order the set
+/// visits them.
+pub struct All<L: Lane, F: FnMut(&Hits<L>)> {
+    f: F,
+    valid: L::Mask,
+    t_end: L,
+    t_max: L,
+}
+
+impl<L: Lane, F: FnMut(&Hits<L>)> All<L, F> {
+    /// The collector for `rays`, calling `f` per hit.
+    #[inline(always)]
+    #[must_use]
+    pub fn new(rays: &RayPacket<L>, f: F) -> Self {
+        let valid = rays.valid();
+        All {
+            f,
+            valid,
+            t_end: rays.t_max,
+            t_max: L::select(valid, relax(rays.t_max), rays.t_max),
+        }
+    }
+}
+
+impl<L: Lane, F: FnMut(&Hits<L>)> Collector<L> for All<L, F> {
+    const EVERY: bool = true;
+
+    #[inline(always)]
+    fn active(&self) -> L::Mask {
+        self.valid
+    }
+
+    #[inline(always)]
+    fn t_max(&self) -> L {
+        self.t_max
+    }
+
+    #[inline(always)]
+    fn offer(
+        &mut self,
+        h: &LaneHit<L>,
+        at: At,
+        record: impl FnOnce(&Winners<L>) -> Hits<L>,
+    ) -> bool {
+        let inside = h.mask & h.t.lt(self.t_end);
+        if inside.any() {
+            let one = LaneHit::deferred(h.t, h.u, h.v, h.w, inside);
+            (self.f)(&record(&Winners::single(&one, at)));
+        }
+        false
+    }
+}
+
+/// How a primitive's records are made from the winners (see the [module docs](self)).
+pub trait Record: Primitive {
+    /// The records of `w`'s lanes; `prim(i)` is lane `i`'s winning primitive (`None` where it
+    /// missed); `cull` is the query's.
+    fn records<L: Lane>(
+        rays: &RayPacket<L>,
+        w: &Winners<L>,
+        cull: Cull,
+        prim: impl Fn(usize) -> Option<Self>,
+    ) -> Hits<L>;
+}
+
+/// Spheres: normal `(o + t·d − c)/|o + t·d − c|` (3 add, 3 mul, 2 add, 1 sqrt, 3 div), flipped
+/// for exit roots (marked by `u = 1`).
+impl Record for Sphere {
+    #[inline]
+    fn records<L: Lane>(
+        rays: &RayPacket<L>,
+        w: &Winners<L>,
+        _cull: Cull,
+        sphere: impl Fn(usize) -> Option<Sphere>,
+    ) -> Hits<L> {
+        if w.mask.none() {
+            return Hits::miss();
+        }
+        let get = |i: usize| {
+            (if w.mask.test(i) { sphere(i) } else { None })
+                .unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN))
+        };
+        let c = V3::<L>::from_fn(|i| get(i).center());
+        let point = rays.origin.along(rays.dir, w.t);
+        let n = unit(point - c, w.mask, |i| {
+            let (o, d, c) = (
+                rays.origin.precise_lane(i),
+                rays.dir.precise_lane(i),
+                c.precise_lane(i),
+            );
+            o.along(d, w.t.precise_lane(i)) - c
+        });
+        let front = w.mask & w.u.lt(L::from_f32(0.5));
+        finish(w, point, V3::select(front, n, -n), front, false)
+    }
+}
+
+/// Triangles: normal `N/|N|` with `N = (B − A) × (C − A)` (6 add, 6 mul, 3 add; then 3 mul,
+/// 2 add, 1 sqrt, 3 div), facing the origin; front: `d·N/|N| < 0` (3 mul, 2 add, 1 cmp), or
+/// every hit under [`Cull::Back`] (the kernel decided it).
+impl Record for Triangle {
+    #[inline]
+    fn records<L: Lane>(
+        rays: &RayPacket<L>,
+        w: &Winners<L>,
+        cull: Cull,
+        tri: impl Fn(usize) -> Option<Triangle>,
+    ) -> Hits<L> {
+        if w.mask.none() {
+            return Hits::miss();
+        }
+        let p = TrianglePacket::<L>::from_fn(|i| {
+            (if w.mask.test(i) { tri(i) } else { None }).unwrap_or(Triangle::never())
+        });
+        let n = unit((p.b - p.a).cross(p.c - p.a), w.mask, |i| {
+            let (a, b, c) = (
+                p.a.precise_lane(i),
+                p.b.precise_lane(i),
+                p.c.precise_lane(i),
+            );
+            (b - a).cross(c - a)
+        });
+        let point = rays.origin.along(rays.dir, w.t);
+        let front = if cull.back() {
+            w.mask
+        } else {
+            w.mask & rays.dir.dot(n).lt(L::from_f32(0.0))
+        };
+        finish(w, point, V3::select(front, n, -n), front, true)
+    }
+}
+
+/// Planes: normal `n/|n|` facing the origin, front `d·n < 0`.
+impl Record for Plane {
+    #[inline]
+    fn records<L: Lane>(
+        rays: &RayPacket<L>,
+        w: &Winners<L>,
+        cull: Cull,
+        plane: impl Fn(usize) -> Option<Plane>,
+    ) -> Hits<L> {
+        if w.mask.none() {
+            return Hits::miss();
+        }
+        let normal = V3::<L>::from_fn(|i| {
+            (if w.mask.test(i) { plane(i) } else { None }).map_or(Vec3::ZERO, |p| p.normal)
+        });
+        let n = unit(normal, w.mask, |i| normal.precise_lane(i));
+        let point = rays.origin.along(rays.dir, w.t);
+        let front = if cull.back() {
+            w.mask
+        } else {
+            w.mask & rays.dir.dot(n).lt(L::from_f32(0.0))
+        };
+        finish(w, point, V3::select(front, n, -n), front, false)
+    }
+}
+
+/// The records from the winners and their point, normal and face.
+#[inline(always)]
+fn finish<L: Lane>(
+    w: &Winners<L>,
+    point: V3<L>,
+    normal: V3<L>,
+    front: L::Mask,
+    barycentrics: bool,
+) -> Hits<L> {
+    let zero = L::from_f32(0.0);
+    let z = V3::new(zero, zero, zero);
+    let m = w.mask;
+    Hits {
+        t: w.t,
+        point: V3::select(m, point, z),
+        normal: V3::select(m, normal, z),
+        front: front & m,
+        index: w.index,
+        set: w.set,
+        u: if barycentrics { w.u } else { zero },
+        v: if barycentrics { w.v } else { zero },
+        mask: m,
+    }
+}
+
+/// `v/|v|` in the lanes of `mask` (3 mul, 2 add, 1 sqrt, 3 div, 2 cmp); lanes whose `|v|²`
+/// lies outside `2^-100…2^100` (under- or overflow) are recomputed from `exact(i)` in `f64`
+/// and rounded; a zero or non-finite vector gives zero.
+#[inline(always)]
+fn unit<L: Lane>(
+    v: V3<L>,
+    mask: L::Mask,
+    exact: impl Fn(usize) -> V3<<L as Lane>::Precise>,
+) -> V3<L> {
+    let n2 = v.length_squared();
+    let n = v.div_by(n2.sqrt());
+    let odd = mask.and_not(n2.ge(L::from_f32(pow2(-100))) & n2.le(L::from_f32(pow2(100))));
+    if odd.any() {
+        precise_unit(n, odd, exact)
+    } else {
+        n
+    }
+}
+
+/// The `lanes` of [`unit`] recomputed in `f64`.
+#[inline(never)]
+fn precise_unit<L: Lane>(
+    mut n: V3<L>,
+    lanes: L::Mask,
+    exact: impl Fn(usize) -> V3<<L as Lane>::Precise>,
+) -> V3<L> {
+    let mut bits = lanes.bits();
+    while bits != 0 {
+        let i = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let w = exact(i);
+        let len = w.length_squared().sqrt();
+        let zero = <L::Precise as Lane>::from_f32(0.0);
+        let u = if (len.gt(zero) & len.is_finite()).any() {
+            w.div_by(len)
+        } else {
+            V3::new(zero, zero, zero)
+        };
+        let round = |x: L::Precise| L::Scalar::from_f64(x.lane(0));
+        n = V3::new(
+            n.x.with_lane(i, round(u.x)),
+            n.y.with_lane(i, round(u.y)),
+            n.z.with_lane(i, round(u.z)),
+        );
+    }
+    n
 }

@@ -55,16 +55,16 @@
 pub mod bounds;
 pub mod bvh;
 pub mod camera;
-#[doc(hidden)]
+pub mod focal;
 pub mod hit;
-#[doc(hidden)]
-pub mod internals;
+pub mod kernel;
 pub mod lane;
 pub mod mesh;
 pub mod opcount;
 pub mod plane;
 pub mod query;
 pub mod ray;
+pub mod set;
 pub mod sphere;
 pub mod triangle;
 pub mod vec3;
@@ -75,8 +75,10 @@ pub mod vec3;
 struct ReadmeDoctests;
 
 pub use camera::Pinhole;
+pub use hit::{Hit, Hits};
+pub use kernel::Cull;
 pub use lane::{Lane, Mask};
-pub use query::{Hit, Hits, Query, Rays, Using};
+pub use query::{Query, Rays};
 pub use ray::{Dir, Ray, Ray4, Ray8, Ray16, RayPacket};
 pub use vec3::V3;
 

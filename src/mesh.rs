@@ -39,14 +39,13 @@
 use glam::Vec3;
 
 use crate::bounds::{self, Bound};
-use crate::hit::{self, Best, LaneHit};
+use crate::hit::{Collector, Hits, Record, Winners};
+use crate::kernel::{Cull, Kernel};
 use crate::lane::{Lane, Mask};
-use crate::query::{self, Hits, Query, TooSmall, Using};
 use crate::ray::RayPacket;
-use crate::sphere::focal::{Focal, FocalKernel, Splat};
-use crate::sphere::{FocalSphere, Sphere};
-use crate::triangle::focal::{self as tf, FocalRays, FocalTriangle};
-use crate::triangle::{Cull, Triangle, TriangleKernel, TrianglePacket};
+use crate::set::{Set, flat, mine};
+use crate::sphere::Sphere;
+use crate::triangle::{Triangle, Watertight};
 
 /// A mesh over borrowed positions and index triples (see the [module docs](self)).
 #[derive(Clone, Copy, Debug)]
@@ -58,16 +57,6 @@ pub struct Mesh<'a> {
     invalid: usize,
     /// The first [`Mesh::LISTED`] of them, ascending.
     listed: [u32; Mesh::LISTED],
-}
-
-/// Empties the interval of the lanes outside `keep`.
-#[inline(always)]
-fn only<L: Lane>(rays: &RayPacket<L>, keep: L::Mask) -> RayPacket<L> {
-    RayPacket {
-        t_min: L::select(keep, rays.t_min, L::from_f32(f32::INFINITY)),
-        t_max: L::select(keep, rays.t_max, L::from_f32(f32::NEG_INFINITY)),
-        ..*rays
-    }
 }
 
 impl<'a> Mesh<'a> {
@@ -126,14 +115,6 @@ impl<'a> Mesh<'a> {
             }
             _ => Triangle::never(),
         }
-    }
-
-    /// The number of focal cache entries [`focus`](Self::focus) needs: one per
-    /// triangle.
-    #[inline]
-    #[must_use]
-    pub fn needed(&self) -> usize {
-        self.len()
     }
 
     /// A mesh with Ritter's bounding sphere of its referenced vertices (one pass over the
@@ -209,294 +190,46 @@ impl<'a> Mesh<'a> {
         }
     }
 
-    /// The rays with culled (and invalid) lanes emptied, or `None` when no lane is left.
-    #[inline]
-    pub(crate) fn kept<L: Lane>(&self, rays: &RayPacket<L>) -> Option<RayPacket<L>> {
-        if self.bound.is_none() {
-            return Some(*rays);
-        }
-        let keep = self.may_hit(rays) & rays.valid();
-        keep.any().then(|| only(rays, keep))
-    }
-
-    /// The closest hit's loop state with kernel `K`, or `None` when the bounding sphere
-    /// excludes every valid lane (then no triangle was tested): for the demo, which counts
-    /// what culling saves.
-    #[doc(hidden)]
-    #[inline]
-    #[must_use]
-    pub fn try_closest<K: TriangleKernel, L: Lane>(
-        &self,
-        rays: &RayPacket<L>,
-        cull: Cull,
-    ) -> Option<Best<L>> {
-        let r = self.kept(rays)?;
-        let pre = K::prepare(&r);
-        Some(hit::closest(&r, 0..self.len(), |r, i| {
-            let t = self.prepared(i);
-            Some(K::intersect(r, &pre, &TrianglePacket::splat(&t), cull))
-        }))
-    }
-
-    /// Lanes whose ray hits some triangle (occlusion), with kernel `K`.
-    #[inline]
-    #[must_use]
-    pub(crate) fn any_lanes<K: TriangleKernel, L: Lane>(
-        &self,
-        rays: &RayPacket<L>,
-        cull: Cull,
-    ) -> L::Mask {
-        let Some(r) = self.kept(rays) else {
-            return Mask::splat(false);
-        };
-        let pre = K::prepare(&r);
-        hit::any(&r, 0..self.len(), |r, i| {
-            let t = self.prepared(i);
-            Some(K::intersect(r, &pre, &TrianglePacket::splat(&t), cull))
-        })
-    }
-
-    /// Every hit: `f(triangle index, hit)` for each triangle some lane hits, in index order.
-    #[inline]
-    pub(crate) fn all_lanes<K: TriangleKernel, L: Lane>(
-        &self,
-        rays: &RayPacket<L>,
-        cull: Cull,
-        mut f: impl FnMut(u32, &LaneHit<L>),
-    ) {
-        let Some(r) = self.kept(rays) else { return };
-        let pre = K::prepare(&r);
-        for i in 0..self.len() {
-            let t = self.prepared(i);
-            let h = K::intersect(&r, &pre, &TrianglePacket::splat(&t), cull);
-            if h.mask.any() {
-                f(i as u32, &h.normalized());
-            }
-        }
-    }
-
-    /// Builds the focal cache of every triangle for rays from `eye` into `out` (entry `i` for
-    /// triangle `i`, from the shared positions, which makes shared edges watertight; invalid
-    /// triangles get entries that are never hit) and returns the cached mesh, which owns `eye`:
-    /// its queries answer rays from `eye` only. `out` shorter than [`needed`](Self::needed) is
-    /// an error (nothing is built); a longer one is used up to `needed`.
-    pub fn focus<'c>(
-        &self,
-        eye: Vec3,
-        out: &'c mut [FocalTriangle<f32>],
-    ) -> Result<FocalMesh<'c>, TooSmall> {
-        let needed = self.needed();
-        let Some(out) = out.get_mut(..needed) else {
-            return Err(TooSmall { needed });
-        };
-        for (i, slot) in out.iter_mut().enumerate() {
-            *slot = match self.triangle(i) {
-                Some(t) => FocalTriangle::new(eye, &t),
-                None => FocalTriangle::never(),
-            };
-        }
-        Ok(FocalMesh {
-            cache: out,
-            bound: self.bound.map(|b| b.focal(eye)),
-            eye,
-            cull: Cull::None,
-        })
-    }
-}
-
-/// A mesh's focal cache for one eye, which it owns, with its bounding sphere as a
-/// [`FocalSphere`]: built by [`Mesh::focus`], queried through [`Query`] (rays from the eye
-/// only).
-#[derive(Clone, Copy, Debug)]
-pub struct FocalMesh<'c> {
-    cache: &'c [FocalTriangle<f32>],
-    bound: Option<FocalSphere<f32>>,
-    /// The eye the entries were built for: queries answer rays from it only.
-    eye: Vec3,
-    /// The culling of [`Query`] calls.
-    cull: Cull,
-}
-
-impl<'c> FocalMesh<'c> {
-    /// A cached mesh from entries built elsewhere (e.g. [`focal::focus`](tf::focus)), without
-    /// a bound.
-    #[must_use]
-    pub fn new(cache: &'c [FocalTriangle<f32>]) -> Self {
-        let eye = cache
-            .iter()
-            .find_map(|e| e.eye())
-            .unwrap_or(Vec3::splat(f32::NAN));
-        FocalMesh {
-            cache,
-            bound: None,
-            eye,
-            cull: Cull::None,
-        }
-    }
-
-    /// The eye: through [`Query`], rays from elsewhere (an origin not exactly equal to it)
-    /// are a miss, never an answer for the wrong rays. NaN for a cache without a valid entry.
-    #[inline]
-    #[must_use]
-    pub fn eye(&self) -> Vec3 {
-        self.eye
-    }
-
-    /// The same cache with [`Query`] calls culled ([`Cull::Back`]: front faces only).
-    #[inline]
-    #[must_use]
-    pub fn culled(self, cull: Cull) -> Self {
-        FocalMesh { cull, ..self }
-    }
-
-    /// The entries.
-    #[inline]
-    #[must_use]
-    pub fn cache(&self) -> &'c [FocalTriangle<f32>] {
-        self.cache
-    }
-
-    /// Lanes the bounding sphere cannot exclude (every lane without a bound): the first step
-    /// of the guarded focal sphere test on the unit directions, `v² > k_lo` with `v = T·U`
-    /// (4 mul, 2 add, 1 cmp). Over the whole line, the cached `k_lo` (`c² − r²` lowered by its
-    /// rounding bound) makes a rejected lane a certain miss, and an eye inside the sphere
-    /// (`k_lo < 0`) rejects none.
-    #[inline]
-    #[must_use]
-    pub fn may_hit<L: Lane>(&self, rays: &FocalRays<L>) -> L::Mask {
+    /// The lanes of `rays` to test: the valid ones the bounding sphere cannot exclude.
+    #[inline(always)]
+    pub(crate) fn kept<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
         match &self.bound {
-            Some(b) => Focal::candidate(&rays.unit_lines(), &Splat(b)),
-            None => Mask::splat(true),
+            Some(b) => b.may_hit(rays) & rays.valid(),
+            None => rays.valid(),
         }
     }
+}
 
-    /// The rays with culled (and invalid) lanes emptied, or `None` when no lane is left.
+/// Meshes: the bounding sphere first (lanes it excludes are not tested), then N rays × 1
+/// triangle in index order; `all` in index order. Default kernel:
+/// [`Watertight`](crate::triangle::Watertight), two-sided.
+impl Set for Mesh<'_> {
+    type Prim = Triangle;
+    type Kernel = Watertight;
+
     #[inline]
-    fn kept<L: Lane>(&self, rays: &FocalRays<L>) -> Option<FocalRays<L>> {
-        if self.bound.is_none() {
-            return Some(*rays);
-        }
-        let keep = self.may_hit(rays) & rays.scaled.valid();
-        keep.any().then(|| FocalRays {
-            scaled: only(&rays.scaled, keep),
-            ..*rays
+    fn trace_with<K: Kernel<Triangle>, L: Lane, C: Collector<L>>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        let keep = self.kept(rays);
+        keep.any()
+            && flat::<Triangle, K, L, C>(rays, keep, cull, set, c, self.len(), |i| self.prepared(i))
+    }
+
+    #[inline]
+    fn records_with<L: Lane>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        w: &Winners<L>,
+    ) -> Hits<L> {
+        Triangle::records(rays, &mine(w, set), cull, |i| {
+            Some(self.prepared(w.loc(i)? as usize))
         })
-    }
-
-    /// The closest hit's loop state for prepared rays from the eye, or `None` when the bounding
-    /// sphere excludes every valid lane (then no triangle was tested): for the demo, which
-    /// counts what culling saves.
-    #[doc(hidden)]
-    #[inline]
-    #[must_use]
-    pub fn try_closest<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> Option<Best<L>> {
-        self.kept(rays)
-            .map(|r| tf::closest_prepared(&r, self.cache, cull))
-    }
-
-    /// Lanes whose ray from the eye hits some triangle (occlusion).
-    #[inline]
-    #[must_use]
-    fn any_lanes<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull) -> L::Mask {
-        match self.kept(rays) {
-            Some(r) => hit::any(&r.scaled, self.cache, |r, e| {
-                tf::maybe_hit(r, &tf::Splat(e), cull)
-            }),
-            None => Mask::splat(false),
-        }
-    }
-
-    /// Every hit: `f(triangle index, hit)` for each triangle some lane hits.
-    #[inline]
-    fn all_lanes<L: Lane>(&self, rays: &FocalRays<L>, cull: Cull, f: impl FnMut(u32, &LaneHit<L>)) {
-        if let Some(r) = self.kept(rays) {
-            tf::all_prepared(&r, self.cache, cull, f);
-        }
-    }
-}
-
-/// Meshes with kernel `K`: the bounding sphere first (lanes it excludes miss), then N rays × 1
-/// triangle in index order; `all` in index order.
-impl<K: TriangleKernel> Query for Using<'_, Mesh<'_>, K> {
-    #[inline]
-    fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
-        let (m, cull) = (self.set(), self.cull());
-        let Some(r) = m.kept(rays) else {
-            return Hits::miss();
-        };
-        let pre = K::prepare(&r);
-        let best = hit::closest(&r, 0..m.len(), |r, i| {
-            Some(K::intersect(
-                r,
-                &pre,
-                &TrianglePacket::splat(&m.prepared(i)),
-                cull,
-            ))
-        });
-        Hits::from_triangles(&r, &best, cull, |i| Some(m.prepared(i as usize)))
-    }
-
-    #[inline]
-    fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
-        self.set().any_lanes::<K, L>(rays, self.cull())
-    }
-
-    fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
-        let (m, cull) = (self.set(), self.cull());
-        m.all_lanes::<K, L>(rays, cull, |i, h| {
-            let best = Best::single(h, i);
-            f(&Hits::from_triangles(rays, &best, cull, |i| {
-                Some(m.prepared(i as usize))
-            }));
-        });
-    }
-}
-
-/// Meshes with the default kernel, [`Watertight`](crate::triangle::Watertight) (two-sided).
-impl Query for Mesh<'_> {
-    #[inline]
-    fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
-        Using::<_, crate::triangle::Watertight>::new(self).closest_packet(rays)
-    }
-    #[inline]
-    fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
-        Using::<_, crate::triangle::Watertight>::new(self).any_packet(rays)
-    }
-    #[inline]
-    fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
-        Using::<_, crate::triangle::Watertight>::new(self).all_packet(rays, f)
-    }
-}
-
-/// Focal meshes: rays whose origin is not exactly the cache's eye miss (see
-/// [`FocalMesh::eye`]); the others are prepared once ([`FocalRays`]), culled by the bound, and
-/// tested against the entries in index order (two passes per block, as
-/// `hit::closest_filtered`). Culling: [`FocalMesh::culled`].
-impl Query for FocalMesh<'_> {
-    #[inline]
-    fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
-        let r = query::at_eye(rays, self.eye);
-        let best = self
-            .try_closest(&FocalRays::new(&r), self.cull)
-            .unwrap_or_else(Best::miss);
-        Hits::from_triangles(&r, &best, self.cull, |i| {
-            self.cache.get(i as usize).map(|e| e.triangle())
-        })
-    }
-
-    #[inline]
-    fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
-        let r = query::at_eye(rays, self.eye);
-        self.any_lanes(&FocalRays::new(&r), self.cull)
-    }
-
-    fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
-        let r = query::at_eye(rays, self.eye);
-        self.all_lanes(&FocalRays::new(&r), self.cull, |i, h| {
-            let best = Best::single(h, i);
-            f(&Hits::from_triangles(&r, &best, self.cull, |i| {
-                self.cache.get(i as usize).map(|e| e.triangle())
-            }));
-        });
     }
 }

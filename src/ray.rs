@@ -15,6 +15,11 @@ use glam::Vec3;
 use crate::lane::Lane;
 use crate::vec3::V3;
 
+/// Largest `| |d|² − 1 |` a unit direction may have (`2^-20`): what [`Dir::new`] guarantees
+/// and what the unit-direction kernels accept (others answer such rays in their own way, see
+/// [`admit`](crate::kernel::admit)).
+pub const UNIT_TOLERANCE: f32 = 1.0 / 1_048_576.0;
+
 /// One ray (the scalar API type, with glam vectors).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
@@ -138,7 +143,7 @@ impl Dir {
         }
         let w = V3::<f32>::from(v / m);
         let d = w.div_by(crate::lane::sqrt_f32(w.length_squared()));
-        let ok = (d.length_squared() - 1.0).abs() <= crate::query::UNIT_TOLERANCE;
+        let ok = (d.length_squared() - 1.0).abs() <= UNIT_TOLERANCE;
         ok.then_some(Dir(d.into()))
     }
 

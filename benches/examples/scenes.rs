@@ -364,48 +364,7 @@ fn bvh_jobs<'a, P: Leaf + 'static>(
                 move || collect(|o| rl::bvh_closest(t, b16, n, o)),
             ),
         ]
-        .into_iter()
-        .chain(
-            eye.map(|e| focal_jobs(all, t, e, b8, b16, keep))
-                .into_iter()
-                .flatten(),
-        )
-        .collect()
     }
-}
-
-/// raylane's BVH in focal mode (primary rays from `eye`): the per-eye cache made inside
-/// every frame (`focus`, leaves filled lazily).
-fn focal_jobs<'a, P: Leaf + 'static>(
-    all: &'a [Ray],
-    t: &'a Bvh<'a, P>,
-    e: Vec3,
-    b8: &'a [RayPacket<f32x8>],
-    b16: &'a [RayPacket<f32x16>],
-    keep: &'a Keep,
-) -> Vec<Job<'a>> {
-    let st: &rl::FocalStore<P> = keep.put(rl::focal_store(t));
-    let (n, every) = (all.len(), (all.len(), true));
-    vec![
-        job(
-            "raylane BVH focal x1",
-            every,
-            move || rl::focal_closest1(t, e, st, all, None),
-            move || collect(|o| rl::focal_closest1(t, e, st, all, o)),
-        ),
-        job(
-            "raylane BVH focal x8",
-            every,
-            move || rl::focal_closest(t, e, st, b8, n, None),
-            move || collect(|o| rl::focal_closest(t, e, st, b8, n, o)),
-        ),
-        job(
-            "raylane BVH focal x16",
-            every,
-            move || rl::focal_closest(t, e, st, b16, n, None),
-            move || collect(|o| rl::focal_closest(t, e, st, b16, n, o)),
-        ),
-    ]
 }
 
 /// Keeps the converted rays of a scene alive while its jobs borrow them.

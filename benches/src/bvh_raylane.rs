@@ -17,13 +17,13 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use raylane::bvh::{
-    self, Bvh, FocalLeaf, FocalNode, Leaf, Node, Primitives, Scratch, Sphere4, Tri4,
-};
-use raylane::internals;
-use raylane::mesh::{FocalMesh, Mesh};
+use raylane::bvh::{self, Bvh, Leaf, Node, Primitives, Scratch, Sphere4, Tri4};
+use raylane::focal::FocalMesh;
+use raylane::mesh::Mesh;
 use raylane::sphere::{Robust, Sphere};
 use raylane::{Lane, Mask, Query, Ray, RayPacket};
+use raylane_lab::loops as internals;
+use raylane_lab::loops::LaneRecords;
 
 use crate::meshes::Answers;
 
@@ -59,7 +59,7 @@ pub fn closest<L: Lane<Scalar = f32>>(
         let mut best = [None; 16];
         let mut mask = L::Mask::splat(false);
         for (k, m) in meshes.iter().enumerate() {
-            let h = m.closest_packet(&r);
+            let h = m.closest(&r);
             if h.mask.any() {
                 r = r.shrink(h.mask, h.t);
                 mask = mask | h.mask;
@@ -98,7 +98,7 @@ pub fn any<L: Lane<Scalar = f32>>(
         let live = r.valid();
         let mut occ = L::Mask::splat(false);
         for m in meshes {
-            let h = m.any_packet(&r);
+            let h = m.any(&r);
             if h.any() {
                 occ = occ | h;
                 if (occ | !live).all() {
@@ -164,12 +164,12 @@ pub struct Tree<P: Leaf> {
 impl<P: Leaf> Tree<P> {
     fn new<Q: Primitives<Leaf = P> + ?Sized>(prims: &Q) -> Self {
         let start = Instant::now();
-        let need = bvh::needed(prims.count());
+        let need = bvh::TriangleBvh::needed(prims.count());
         let mut nodes = vec![Node::EMPTY; need.nodes];
         let mut leaves = vec![P::EMPTY; need.leaves];
         let mut scratch = vec![Scratch::default(); need.scratch];
         let (n, l) = {
-            let t = bvh::build(prims, &mut nodes, &mut leaves, &mut scratch)
+            let t = bvh::Bvh::build(prims, &mut nodes, &mut leaves, &mut scratch)
                 .expect("storage from bvh::needed");
             (t.nodes().len(), t.leaves().len())
         };
@@ -208,56 +208,6 @@ impl Tree<Sphere4> {
     }
 }
 
-/// Per-eye storage for a [`raylane::bvh::FocalBvh`] of `t` (filled by `focus` inside each
-/// timed frame).
-pub type FocalStore<P> = std::cell::RefCell<(Vec<FocalNode>, Vec<FocalLeaf<P>>)>;
-
-/// Storage for [`FocalStore`] of `t`.
-pub fn focal_store<P: Leaf>(t: &Bvh<P>) -> FocalStore<P> {
-    let (n, l) = bvh::focal_needed(t);
-    std::cell::RefCell::new((vec![FocalNode::EMPTY; n], vec![FocalLeaf::EMPTY; l]))
-}
-
-/// Closest hits of single rays through `t` focused on `eye` (the focus inside the timing).
-#[inline(never)]
-pub fn focal_closest1<P: Leaf>(
-    t: &Bvh<P>,
-    eye: Vec3,
-    store: &FocalStore<P>,
-    rays: &[Ray],
-    out: Option<&mut Answers>,
-) -> u32 {
-    focused(t, eye, store, |f| bvh_closest1(f, rays, out))
-}
-
-/// `run` on `t` focused on `eye` in `store`'s storage.
-fn focused<P: Leaf, R>(
-    t: &Bvh<P>,
-    eye: Vec3,
-    store: &FocalStore<P>,
-    run: impl FnOnce(&bvh::FocalBvh<'_, '_, P>) -> R,
-) -> R {
-    let mut s = store.borrow_mut();
-    let (nodes, leaves) = &mut *s;
-    let f = t
-        .focus(eye, nodes, leaves)
-        .expect("storage from focal_needed");
-    run(&f)
-}
-
-/// Closest hits of ray packets through `t` focused on `eye` (the focus inside the timing).
-#[inline(never)]
-pub fn focal_closest<P: Leaf, L: Lane<Scalar = f32>>(
-    t: &Bvh<P>,
-    eye: Vec3,
-    store: &FocalStore<P>,
-    packets: &[RayPacket<L>],
-    rays: usize,
-    out: Option<&mut Answers>,
-) -> u32 {
-    focused(t, eye, store, |f| bvh_closest(f, packets, rays, out))
-}
-
 /// Closest hits of single rays through the BVH.
 #[inline(never)]
 pub fn bvh_closest1(t: &impl Query, rays: &[Ray], mut out: Option<&mut Answers>) -> u32 {
@@ -283,7 +233,7 @@ pub fn bvh_closest<L: Lane<Scalar = f32>>(
 ) -> u32 {
     let mut n = 0;
     for p in packets {
-        let h = t.closest_packet(black_box(p));
+        let h = t.closest(black_box(p));
         n += h.mask.bits().count_ones();
         if let Some(o) = out.as_deref_mut() {
             o.extend((0..L::LANES).map(|i| h.lane(i).map(|r| (r.t, r.index))));
@@ -320,7 +270,7 @@ pub fn bvh_any<L: Lane<Scalar = f32>>(
 ) -> u32 {
     let mut n = 0;
     for p in packets {
-        let m = t.any_packet(black_box(p));
+        let m = t.any(black_box(p));
         n += m.bits().count_ones();
         if let Some(o) = out.as_deref_mut() {
             o.extend((0..L::LANES).map(|i| m.test(i).then_some((0.0, 0))));

@@ -15,14 +15,15 @@
 use std::hint::black_box;
 
 use glam::Vec3;
-use raylane::internals;
-use raylane::internals::Best;
-use raylane::internals::HitRecord;
+use raylane::Cull;
 use raylane::plane::{FocalPlane, Plane, PlanePacket};
 use raylane::sphere::focal::{self as sf, FocalKernel};
 use raylane::sphere::{FocalSphere, Sphere, SphereKernel, SpherePacket};
-use raylane::triangle::{Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
+use raylane::triangle::{FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
 use raylane::{Lane, Mask, Pinhole, Ray, RayPacket};
+use raylane_lab::loops as internals;
+use raylane_lab::loops::HitRecord;
+use raylane_lab::loops::{Best, LaneRecords};
 
 pub mod bvh_raylane;
 pub mod meshes;

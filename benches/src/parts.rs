@@ -11,9 +11,12 @@
 use std::hint::black_box;
 
 use glam::Vec3;
-use raylane::mesh::{FocalMesh, Mesh};
+use raylane::focal::FocalMesh;
+use raylane::hit::{Closest, Winners};
+use raylane::mesh::Mesh;
+use raylane::set::Trace;
 use raylane::triangle::{FocalTriangle, Triangle};
-use raylane::{Hits, Lane, Mask, Query, RayPacket};
+use raylane::{Lane, Mask, RayPacket};
 
 /// Triangles in parts, each part its own vertex and index arrays (unshared vertices).
 pub struct Parts {
@@ -82,7 +85,7 @@ impl Parts {
 
     /// The parts as focal meshes for rays from `eye`, each with its bounding sphere (Ritter).
     pub fn focus<'c>(
-        &self,
+        &'c self,
         eye: Vec3,
         storage: &'c mut [Vec<FocalTriangle<f32>>],
     ) -> Vec<FocalMesh<'c>> {
@@ -92,7 +95,8 @@ impl Parts {
             .zip(storage.iter_mut())
             .map(|((p, i), out)| {
                 let mesh = Mesh::bounded(p, i);
-                mesh.focus(eye, out).expect("storage() sizes every cache")
+                raylane::focal::FocalMesh::new(&mesh, eye, out)
+                    .expect("storage() sizes every cache")
             })
             .collect()
     }
@@ -129,13 +133,13 @@ fn split(
 
 /// The closest hit of one packet of rays from the meshes' eye over every part.
 #[inline(always)]
-fn closest<L: Lane>(rays: &RayPacket<L>, meshes: &[FocalMesh]) -> Hits<L> {
-    let mut best = Hits::<L>::miss();
-    for m in meshes {
+fn closest<L: Lane>(rays: &RayPacket<L>, meshes: &[FocalMesh]) -> Winners<L> {
+    let mut c = Closest::new(rays);
+    for (k, m) in meshes.iter().enumerate() {
         // The bounding sphere first, then the triangles; ties keep the earlier part.
-        best.merge(&m.closest(rays));
+        m.trace(rays, k as u32, &mut c);
     }
-    best
+    c.finish()
 }
 
 /// One frame: the closest hit of every packet over the parts; returns the number of lanes hit.

@@ -101,12 +101,12 @@ impl Tree {
     /// Builds the tree over `tris`.
     pub fn new(tris: &[Triangle]) -> Result<Self, bvh::BuildError> {
         let start = Instant::now();
-        let need = bvh::needed(tris.len());
+        let need = bvh::TriangleBvh::needed(tris.len());
         let mut nodes = vec![Node::EMPTY; need.nodes];
         let mut leaves = vec![<Tri4 as bvh::Packed>::EMPTY; need.leaves];
         let mut scratch = vec![Scratch::default(); need.scratch];
         let (n, l) = {
-            let t = bvh::build(tris, &mut nodes, &mut leaves, &mut scratch)?;
+            let t = bvh::Bvh::build(tris, &mut nodes, &mut leaves, &mut scratch)?;
             (t.nodes().len(), t.leaves().len())
         };
         nodes.truncate(n);
@@ -201,7 +201,7 @@ pub fn render<L: Lane<Scalar = f32>>(
         let mut row = Vec::with_capacity(w as usize);
         for x in (0..w).step_by(L::LANES) {
             let p = cam.row_packet::<L>(x, y);
-            let hit = tree.closest_packet(&p);
+            let hit = tree.closest(&p);
             for i in 0..L::LANES.min((w - x) as usize) {
                 row.push(hit.lane(i).map(|r| (p.ray(i), r.t, r.index)));
             }
@@ -231,7 +231,7 @@ pub fn render<L: Lane<Scalar = f32>>(
             .collect();
         let mut blocked = Vec::with_capacity(shadows.len());
         for chunk in shadows.chunks(L::LANES) {
-            let m = tree.any_packet(&RayPacket::<L>::from_rays(chunk));
+            let m = tree.any(&RayPacket::<L>::from_rays(chunk));
             blocked.extend((0..chunk.len()).map(|i| raylane::Mask::test(m, i)));
         }
         blocked

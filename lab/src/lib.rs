@@ -6,6 +6,8 @@
 //! allocation so that the firmware runs the same code:
 //!
 //! * [`registry`]: the one list of kernels, which every tool below walks;
+//! * [`loops`]: every kernel over slices in both packet shapes (N rays × 1 primitive, 1 ray ×
+//!   N primitives), for the tests that compare them and the benchmarks that time a kernel;
 //! * [`vectors`]: the test-vector parser, the batched runner and the result digest that every
 //!   target must reproduce;
 //! * [`opcount`]: the op-count report (every kernel's paths measured with the counting lane);
@@ -17,6 +19,7 @@
 #![deny(missing_docs)]
 
 pub mod demo;
+pub mod loops;
 pub mod opcount;
 pub mod registry;
 pub mod study;

@@ -110,13 +110,14 @@ mod examples {
 
     use super::{Counted, OpCounts, Table, measure};
     use crate::registry::{Kernel, Visitor};
+    use raylane::Cull;
     use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
     use raylane::ray::{Ray, RayPacket};
     use raylane::sphere::focal::FocalKernel;
     use raylane::sphere::{self as sp, FocalSphere, Geometric, SphereKernel, SpherePacket};
     use raylane::triangle::focal as tf;
     use raylane::triangle::focal::FocalRays;
-    use raylane::triangle::{Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
+    use raylane::triangle::{FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
 
     type C = Counted<f32>;
 

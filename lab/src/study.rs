@@ -26,6 +26,7 @@ use core::mem::size_of;
 use glam::Vec3;
 
 use crate::opcount::table;
+use raylane::Cull;
 use raylane::lane::{Lane, Mask};
 use raylane::opcount::{Counted, OpCounts, measure};
 use raylane::ray::{Ray, RayPacket};
@@ -36,9 +37,8 @@ use raylane::sphere::{
 };
 use raylane::triangle::focal::FocalRays;
 use raylane::triangle::{
-    Badouel, BaldwinWeber, Cramer, Cull, FocalTriangle, HavelHerout, KenslerShirley, Moller,
-    Plucker, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
-    focal as tf,
+    Badouel, BaldwinWeber, Cramer, FocalTriangle, HavelHerout, KenslerShirley, Moller, Plucker,
+    PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight, focal as tf,
 };
 
 type C = Counted<f32>;
@@ -520,7 +520,7 @@ pub fn repeat<L: Lane<Scalar = f32>>(index: usize, path: Path, n: usize) -> Opti
             let ray = triangle_rays()[usize::from(hit)];
             let rp = black_box(RayPacket::<L>::splat(&ray));
             let tp = TrianglePacket::<L>::splat(&triangle());
-            let lane_hits = |h: &raylane::hit::LaneHit<L>| h.mask.bits().count_ones();
+            let lane_hits = |h: &raylane::kernel::LaneHit<L>| h.mask.bits().count_ones();
             fn plain<K: TriangleKernel, L: Lane<Scalar = f32>>(
                 n: usize,
                 rp: &RayPacket<L>,

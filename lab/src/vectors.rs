@@ -29,14 +29,15 @@ use core::hash::Hasher as _;
 use glam::Vec3;
 
 use crate::registry::{Kernel, Visitor};
-use raylane::hit::LaneHit;
+use raylane::Cull;
+use raylane::kernel::LaneHit;
 use raylane::lane::{Lane, MAX_LANES, Mask};
 use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
 use raylane::ray::RayPacket;
 use raylane::sphere::focal::FocalKernel;
 use raylane::sphere::{FocalSphere, Roots, Sphere, SphereKernel, SpherePacket};
 use raylane::triangle::focal::FocalRays;
-use raylane::triangle::{self, Cull, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
+use raylane::triangle::{self, FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
 use raylane::vec3::V3;
 
 /// Relative tolerance on `t`.

@@ -2,9 +2,9 @@
 
 use super::{
     BINS, BuildError, Bvh, EMPTY, LEAF, LEAF_WIDTH, MAX_PRIMITIVES, Node, Packed, Primitives,
-    SAH_DEPTH, Scratch, WIDTH, area, max, min, needed, reach,
+    SAH_DEPTH, Scratch, WIDTH, area, max, min, reach, sizes,
 };
-use crate::triangle::Cull;
+use crate::set::TooSmall;
 
 type Box3 = ([f32; 3], [f32; 3]);
 
@@ -283,14 +283,8 @@ fn unjob(j: &Node) -> ([u32; 4], Lanes, Box3) {
     (w, j.bounds[0], (lo, hi))
 }
 
-/// Builds a tree over `prims` into `nodes`, `leaves` (sizes from [`needed`]) using `scratch`
-/// as working memory. See the [module docs](super) for the algorithm and layout.
-///
-/// # Errors
-///
-/// [`BuildError`] when a slice is shorter than [`needed`] gives, or for more than
-/// [`MAX_PRIMITIVES`]. Nothing is written to `leaves` beyond the first error.
-pub fn build<'s, P: Primitives + ?Sized>(
+/// [`Bvh::build`].
+pub(crate) fn build<'s, P: Primitives + ?Sized>(
     prims: &P,
     nodes: &'s mut [Node],
     leaves: &'s mut [P::Leaf],
@@ -300,15 +294,16 @@ pub fn build<'s, P: Primitives + ?Sized>(
     if n > MAX_PRIMITIVES {
         return Err(BuildError::TooMany);
     }
-    let need = needed(n);
+    let need = sizes(n);
+    let short = |needed| TooSmall { needed };
     if nodes.len() < need.nodes {
-        return Err(BuildError::Nodes(need.nodes));
+        return Err(BuildError::Nodes(short(need.nodes)));
     }
     if leaves.len() < need.leaves {
-        return Err(BuildError::Leaves(need.leaves));
+        return Err(BuildError::Leaves(short(need.leaves)));
     }
     if scratch.len() < need.scratch {
-        return Err(BuildError::Scratch(need.scratch));
+        return Err(BuildError::Scratch(short(need.scratch)));
     }
     let s = &mut scratch[..n];
     let (mut b, mut cb) = (EMPTY_LANES, EMPTY_BOX);
@@ -401,7 +396,9 @@ pub fn build<'s, P: Primitives + ?Sized>(
             if (b - a) as usize <= LEAF_WIDTH {
                 let slot = leaves
                     .get_mut(used_leaves)
-                    .ok_or(BuildError::Leaves(used_leaves + 1))?;
+                    .ok_or(BuildError::Leaves(TooSmall {
+                        needed: used_leaves + 1,
+                    }))?;
                 *slot = P::Leaf::EMPTY;
                 for (lane, p) in s[a as usize..b as usize].iter().enumerate() {
                     prims.put(p.index, slot, lane);
@@ -410,7 +407,9 @@ pub fn build<'s, P: Primitives + ?Sized>(
                 used_leaves += 1;
             } else {
                 if used_nodes >= nodes.len() {
-                    return Err(BuildError::Nodes(used_nodes + 1));
+                    return Err(BuildError::Nodes(TooSmall {
+                        needed: used_nodes + 1,
+                    }));
                 }
                 nodes[used_nodes] = job([a, b, depth + 1, top], &kid.b, &kid.cb);
                 out.child[k] = used_nodes as u32;
@@ -426,21 +425,11 @@ pub fn build<'s, P: Primitives + ?Sized>(
         nodes,
         leaves,
         reach: reach(&nodes[0]),
-        cull: Cull::None,
     })
 }
 
-/// Rewrites the leaves from `prims` (same indices, new coordinates) and recomputes every box,
-/// children before parents (inner children always follow their parent). `nodes` and `leaves`
-/// must be exactly the slices a [`build`] over a set of the same size returned
-/// ([`Bvh::nodes`], [`Bvh::leaves`]). The topology stays the build's: after large moves a
-/// rebuild gives a cheaper tree, but the answers are exact either way.
-///
-/// # Errors
-///
-/// [`BuildError::Mismatch`] when a leaf holds an index past `prims.count()` or a child index is
-/// out of range (nothing is then guaranteed about the slices' boxes).
-pub fn refit<'s, P: Primitives + ?Sized>(
+/// [`Bvh::refit`].
+pub(crate) fn refit<'s, P: Primitives + ?Sized>(
     prims: &P,
     nodes: &'s mut [Node],
     leaves: &'s mut [P::Leaf],
@@ -449,6 +438,13 @@ pub fn refit<'s, P: Primitives + ?Sized>(
         return Err(BuildError::Mismatch);
     }
     let n = prims.count();
+    let held: usize = leaves
+        .iter()
+        .map(|l| l.indices().iter().filter(|&&i| i != EMPTY).count())
+        .sum();
+    if held != n {
+        return Err(BuildError::Mismatch);
+    }
     for leaf in leaves.iter_mut() {
         let idx = *leaf.indices();
         *leaf = P::Leaf::EMPTY;
@@ -504,6 +500,5 @@ pub fn refit<'s, P: Primitives + ?Sized>(
         nodes,
         leaves,
         reach: reach(&nodes[0]),
-        cull: Cull::None,
     })
 }

@@ -5,13 +5,12 @@ use glam::Vec3;
 use wide::f32x4;
 
 use super::{EMPTY, LEAF_WIDTH, max, min};
-use crate::hit::{Best, LaneHit};
-use crate::lane::{Lane, Mask};
+use crate::hit::Record;
+use crate::kernel::{Kernel, Primitive};
+use crate::lane::Lane;
 use crate::mesh::Mesh;
-use crate::query::{Hits, Query, Using, sphere_hit};
-use crate::ray::RayPacket;
-use crate::sphere::{Robust, Sphere, SphereKernel, SpherePacket};
-use crate::triangle::{Cull, Shear, Triangle, TriangleKernel, TrianglePacket, Watertight};
+use crate::sphere::{Robust, Sphere, SpherePacket};
+use crate::triangle::{Triangle, TrianglePacket, Watertight};
 use crate::vec3::V3;
 
 /// What the builder and the refit need of a leaf: up to [`LEAF_WIDTH`] primitives (or
@@ -26,111 +25,19 @@ pub trait Packed: Copy + core::fmt::Debug {
     fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]);
 }
 
-/// A leaf of primitives with their kernels (unused lanes hold NaN geometry, never hit).
+/// A leaf of primitives a kernel tests: up to [`LEAF_WIDTH`] of one kind in lanes (unused
+/// lanes hold geometry that is never hit).
 pub trait Leaf: Packed {
     /// The primitive type.
-    type Prim: Copy;
+    type Prim: Record;
+    /// The kernel of a plain query ([`Watertight`] for triangles, [`Robust`] for spheres).
+    type Kernel: Kernel<Self::Prim>;
     /// The primitive in lane `k` (one that is never hit for an unused lane).
     fn prim(&self, k: usize) -> Self::Prim;
-    /// The query records of the winners in `best` (`prim(i)`: the primitive of index `i`),
-    /// as the flat sets make them ([`Hits::from_triangles`], [`Hits::from_spheres`]).
-    fn records<L: Lane>(
-        rays: &RayPacket<L>,
-        best: &Best<L>,
-        cull: Cull,
-        prim: impl Fn(u32) -> Option<Self::Prim>,
-    ) -> Hits<L>;
-    /// Every hit of `rays` on `prim` (index `index`), as the flat set's `all` reports it.
-    fn all<L: Lane>(
-        prim: &Self::Prim,
-        index: u32,
-        rays: &RayPacket<L>,
-        cull: Cull,
-        f: &mut dyn FnMut(&Hits<L>),
-    );
-    /// Per-ray constants of the leaf kernel.
-    type Rays<L: Lane>: Copy;
-    /// The per-ray constants of `rays`.
-    fn prepare<L: Lane>(rays: &RayPacket<L>) -> Self::Rays<L>;
-    /// N rays × 1 primitive: lane `k`'s primitive splatted against the rays.
-    fn test_one<L: Lane>(
-        &self,
-        k: usize,
-        rays: &RayPacket<L>,
-        pre: &Self::Rays<L>,
-        cull: Cull,
-    ) -> LaneHit<L>;
-    /// 1 ray × 4 primitives: the ray splatted against the leaf's lanes (the same candidate
-    /// per lane as [`test_one`](Self::test_one)).
-    fn test_four(
-        &self,
-        ray: &RayPacket<f32x4>,
-        pre: &Self::Rays<f32x4>,
-        cull: Cull,
-    ) -> LaneHit<f32x4>;
-    /// What the per-eye cache of a [`FocalBvh`](super::FocalBvh) keeps of a leaf
-    /// ([`RelTri4`]: the vertices minus the eye; `()` for spheres, whose kernel's fallback
-    /// needs the centre itself).
-    type Rel: Copy + core::fmt::Debug;
-    /// The cache entry of a leaf not yet reached.
-    const REL_EMPTY: Self::Rel;
-    /// The cache entry for rays from `eye`.
-    fn relative(&self, eye: Vec3) -> Self::Rel;
-    /// [`test_four`](Self::test_four) for rays from the eye `rel` was made for: the same bits
-    /// (by default `test_four` itself, for leaves that cache nothing).
-    #[inline(always)]
-    fn test_four_rel(
-        &self,
-        _rel: &Self::Rel,
-        ray: &RayPacket<f32x4>,
-        pre: &Self::Rays<f32x4>,
-        cull: Cull,
-    ) -> LaneHit<f32x4> {
-        self.test_four(ray, pre, cull)
-    }
-    /// [`test_one`](Self::test_one) for rays from the eye `rel` was made for: the same bits
-    /// (by default `test_one` itself).
-    #[inline(always)]
-    fn test_one_rel<L: Lane>(
-        &self,
-        _rel: &Self::Rel,
-        k: usize,
-        rays: &RayPacket<L>,
-        pre: &Self::Rays<L>,
-        cull: Cull,
-    ) -> LaneHit<L> {
-        self.test_one(k, rays, pre, cull)
-    }
-}
-
-/// Four triangles' vertices minus an eye (`A − E`, `B − E`, `C − E`, each coordinate rounded
-/// once, as the [`Watertight`] kernel's first step computes them for rays from `E`): what a
-/// [`FocalBvh`](super::FocalBvh) caches per leaf. 144 bytes.
-#[repr(C, align(16))]
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RelTri4 {
-    /// `A − E`: x, y, z lanes.
-    pub a: [[f32; LEAF_WIDTH]; 3],
-    /// `B − E`.
-    pub b: [[f32; LEAF_WIDTH]; 3],
-    /// `C − E`.
-    pub c: [[f32; LEAF_WIDTH]; 3],
-}
-
-impl RelTri4 {
-    /// No triangles (NaN: never hit).
-    pub const EMPTY: Self = RelTri4 {
-        a: [[f32::NAN; LEAF_WIDTH]; 3],
-        b: [[f32::NAN; LEAF_WIDTH]; 3],
-        c: [[f32::NAN; LEAF_WIDTH]; 3],
-    };
-}
-
-/// `v − eye`, lane by lane.
-#[inline(always)]
-fn minus(v: &[[f32; LEAF_WIDTH]; 3], eye: Vec3) -> [[f32; LEAF_WIDTH]; 3] {
-    let e = eye.to_array();
-    core::array::from_fn(|a| v[a].map(|x| x - e[a]))
+    /// Lane `k`'s primitive in every lane (N rays × 1 primitive).
+    fn splat<L: Lane>(&self, k: usize) -> <Self::Prim as Primitive>::Packet<L>;
+    /// The leaf's primitives in `f32x4` lanes (1 ray × 4 primitives).
+    fn four(&self) -> <Self::Prim as Primitive>::Packet<f32x4>;
 }
 
 /// A set of primitives a tree can be built over.
@@ -240,109 +147,29 @@ impl Packed for Tri4 {
 
 impl Leaf for Tri4 {
     type Prim = Triangle;
+    type Kernel = Watertight;
 
+    #[inline]
     fn prim(&self, k: usize) -> Triangle {
         self.triangle(k)
     }
 
-    #[inline]
-    fn records<L: Lane>(
-        rays: &RayPacket<L>,
-        best: &Best<L>,
-        cull: Cull,
-        prim: impl Fn(u32) -> Option<Triangle>,
-    ) -> Hits<L> {
-        Hits::from_triangles(rays, best, cull, prim)
-    }
-
-    fn all<L: Lane>(
-        prim: &Triangle,
-        index: u32,
-        rays: &RayPacket<L>,
-        cull: Cull,
-        f: &mut dyn FnMut(&Hits<L>),
-    ) {
-        Using::<[Triangle], Watertight>::new(core::slice::from_ref(prim))
-            .culled(cull)
-            .all_packet(rays, &mut |h: &Hits<L>| f(&reindex(h, index)));
-    }
-
-    type Rays<L: Lane> = Shear<L>;
-
     #[inline(always)]
-    fn prepare<L: Lane>(rays: &RayPacket<L>) -> Shear<L> {
-        Watertight::prepare(rays)
-    }
-
-    #[inline(always)]
-    fn test_one<L: Lane>(
-        &self,
-        k: usize,
-        rays: &RayPacket<L>,
-        pre: &Shear<L>,
-        cull: Cull,
-    ) -> LaneHit<L> {
-        let tri = TrianglePacket {
+    fn splat<L: Lane>(&self, k: usize) -> TrianglePacket<L> {
+        TrianglePacket {
             a: V3::splat(get(&self.a, k)),
             b: V3::splat(get(&self.b, k)),
             c: V3::splat(get(&self.c, k)),
-        };
-        Watertight::intersect(rays, pre, &tri, cull)
-    }
-
-    #[inline(always)]
-    fn test_four(&self, ray: &RayPacket<f32x4>, pre: &Shear<f32x4>, cull: Cull) -> LaneHit<f32x4> {
-        let tri = TrianglePacket {
-            a: lanes4(&self.a),
-            b: lanes4(&self.b),
-            c: lanes4(&self.c),
-        };
-        Watertight::intersect(ray, pre, &tri, cull)
-    }
-
-    type Rel = RelTri4;
-    const REL_EMPTY: RelTri4 = RelTri4::EMPTY;
-
-    #[inline]
-    fn relative(&self, eye: Vec3) -> RelTri4 {
-        RelTri4 {
-            a: minus(&self.a, eye),
-            b: minus(&self.b, eye),
-            c: minus(&self.c, eye),
         }
     }
 
     #[inline(always)]
-    fn test_four_rel(
-        &self,
-        rel: &RelTri4,
-        ray: &RayPacket<f32x4>,
-        pre: &Shear<f32x4>,
-        cull: Cull,
-    ) -> LaneHit<f32x4> {
-        let tri = TrianglePacket {
-            a: lanes4(&rel.a),
-            b: lanes4(&rel.b),
-            c: lanes4(&rel.c),
-        };
-        Watertight::intersect_relative(ray, pre, &tri, cull)
-    }
-
-    #[inline(always)]
-    fn test_one_rel<L: Lane>(
-        &self,
-        rel: &RelTri4,
-        k: usize,
-        rays: &RayPacket<L>,
-        pre: &Shear<L>,
-        cull: Cull,
-    ) -> LaneHit<L> {
-        let tri = TrianglePacket {
-            a: V3::splat(get(&rel.a, k)),
-            b: V3::splat(get(&rel.b, k)),
-            c: V3::splat(get(&rel.c, k)),
-        };
-        Watertight::intersect_relative(rays, pre, &tri, cull)
+    fn four(&self) -> TrianglePacket<f32x4> {
+        TrianglePacket {
+            a: lanes4(&self.a),
+            b: lanes4(&self.b),
+            c: lanes4(&self.c),
+        }
     }
 }
 
@@ -365,76 +192,28 @@ impl Packed for Sphere4 {
 
 impl Leaf for Sphere4 {
     type Prim = Sphere;
+    type Kernel = Robust;
 
+    #[inline]
     fn prim(&self, k: usize) -> Sphere {
         Sphere::new(get(&self.center, k), self.radius[k])
     }
 
-    #[inline]
-    fn records<L: Lane>(
-        rays: &RayPacket<L>,
-        best: &Best<L>,
-        _cull: Cull,
-        prim: impl Fn(u32) -> Option<Sphere>,
-    ) -> Hits<L> {
-        Hits::from_spheres(rays, best, prim)
-    }
-
-    fn all<L: Lane>(
-        prim: &Sphere,
-        index: u32,
-        rays: &RayPacket<L>,
-        cull: Cull,
-        f: &mut dyn FnMut(&Hits<L>),
-    ) {
-        Using::<[Sphere], Robust>::new(core::slice::from_ref(prim))
-            .culled(cull)
-            .all_packet(rays, &mut |h: &Hits<L>| f(&reindex(h, index)));
-    }
-
-    type Rays<L: Lane> = ();
-
     #[inline(always)]
-    fn prepare<L: Lane>(_rays: &RayPacket<L>) {}
-
-    #[inline(always)]
-    fn test_one<L: Lane>(&self, k: usize, rays: &RayPacket<L>, _: &(), cull: Cull) -> LaneHit<L> {
-        let s = SpherePacket {
+    fn splat<L: Lane>(&self, k: usize) -> SpherePacket<L> {
+        SpherePacket {
             center: V3::splat(get(&self.center, k)),
             radius: L::from_f32(self.radius[k]),
-        };
-        sphere_hit(&Robust::roots(rays, &s), cull)
-    }
-
-    #[inline(always)]
-    fn test_four(&self, ray: &RayPacket<f32x4>, _: &(), cull: Cull) -> LaneHit<f32x4> {
-        let s = SpherePacket {
-            center: lanes4(&self.center),
-            radius: f32x4::new(self.radius),
-        };
-        sphere_hit(&Robust::roots(ray, &s), cull)
-    }
-
-    type Rel = ();
-    const REL_EMPTY: () = ();
-
-    #[inline(always)]
-    fn relative(&self, _eye: Vec3) {}
-}
-
-/// `h` with primitive index `index` in every lane that hit (the one-element set's records
-/// carry 0).
-fn reindex<L: Lane>(h: &Hits<L>, index: u32) -> Hits<L> {
-    let mut h = *h;
-    let mut bits = h.mask.bits();
-    while bits != 0 {
-        let i = bits.trailing_zeros() as usize;
-        bits &= bits - 1;
-        if let Some(x) = h.index.as_mut().get_mut(i) {
-            *x = index;
         }
     }
-    h
+
+    #[inline(always)]
+    fn four(&self) -> SpherePacket<f32x4> {
+        SpherePacket {
+            center: lanes4(&self.center),
+            radius: f32x4::new(self.radius),
+        }
+    }
 }
 
 /// `c ± r` (the empty box for an invalid sphere: NaN radius).

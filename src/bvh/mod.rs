@@ -58,7 +58,7 @@
 //! leaf vertices, the same answers).
 //!
 //! ```
-//! use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
+//! use raylane::bvh::{Bvh, Node, Packed, Scratch, Tri4, TriangleBvh};
 //! use raylane::glam::Vec3;
 //! use raylane::triangle::Triangle;
 //! use raylane::{Query, Ray};
@@ -69,11 +69,11 @@
 //!         Triangle::new(Vec3::new(x, 0.0, 0.0), Vec3::new(x + 1.0, 0.0, 0.0), Vec3::new(x, 1.0, 0.0))
 //!     })
 //!     .collect();
-//! let need = bvh::needed(tris.len());
+//! let need = TriangleBvh::needed(tris.len());
 //! let mut nodes = vec![Node::EMPTY; need.nodes];
 //! let mut leaves = vec![Tri4::EMPTY; need.leaves];
 //! let mut scratch = vec![Scratch::default(); need.scratch];
-//! let tree = bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch).unwrap();
+//! let tree = Bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch).unwrap();
 //! let ray = Ray::new(Vec3::new(42.25, 0.25, 1.0), Vec3::new(0.0, 0.0, -1.0));
 //! let hit = tree.closest(&ray).unwrap();
 //! assert_eq!((hit.index, hit.t), (42, 1.0));
@@ -112,18 +112,22 @@
 //! on the triangles' order; rays with `t_max = +inf` are never affected.
 
 mod build;
-pub mod focal;
 mod leaf;
-mod query;
+pub mod node;
 pub mod scene;
 mod traverse;
 
-pub use build::{build, refit};
-pub use focal::{FocalBvh, FocalLeaf, FocalNode, NodeCache, NodeRows, SphereNode, focal_needed};
-pub use leaf::{Leaf, Packed, Primitives, RelTri4, Sphere4, Tri4};
+pub use leaf::{Leaf, Packed, Primitives, Sphere4, Tri4};
+pub use node::{Layout, Node};
 pub use scene::{Inst4, Instance, Scene};
 
-use crate::triangle::Cull;
+use wide::f32x4;
+
+use crate::hit::{At, Collector, Hits, Record, Winners};
+use crate::kernel::{Cull, Kernel, LaneHit, admit};
+use crate::lane::{Lane, Mask};
+use crate::ray::{Ray, RayPacket, UNIT_TOLERANCE};
+use crate::set::{Set, TooSmall, mine};
 
 /// Children per node (the lanes of one slab test).
 pub const WIDTH: usize = 8;
@@ -146,42 +150,6 @@ pub const EMPTY: u32 = u32::MAX;
 /// The bit that marks `child[k]` as a leaf index.
 pub const LEAF: u32 = 1 << 31;
 
-/// One inner node: the boxes of up to [`WIDTH`] children in structure-of-arrays lanes.
-///
-/// `bounds[0..3]` are the children's minimum x, y, z, `bounds[3..6]` their maximum x, y, z
-/// (`bounds[axis][k]` is child `k`'s). Unused slots have `min = +inf`, `max = −inf` and
-/// `child = EMPTY`. 224 bytes, aligned to 32.
-#[repr(C, align(32))]
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Node {
-    /// Children's boxes: min x, y, z, then max x, y, z; lane `k` is child `k`.
-    pub bounds: [[f32; WIDTH]; 6],
-    /// Children: [`EMPTY`], `LEAF | leaf index`, or an inner node's index (greater than this
-    /// node's).
-    pub child: [u32; WIDTH],
-}
-
-impl Node {
-    /// A node with no children.
-    pub const EMPTY: Node = Node {
-        bounds: [
-            [f32::INFINITY; WIDTH],
-            [f32::INFINITY; WIDTH],
-            [f32::INFINITY; WIDTH],
-            [f32::NEG_INFINITY; WIDTH],
-            [f32::NEG_INFINITY; WIDTH],
-            [f32::NEG_INFINITY; WIDTH],
-        ],
-        child: [EMPTY; WIDTH],
-    };
-}
-
-impl Default for Node {
-    fn default() -> Self {
-        Node::EMPTY
-    }
-}
-
 /// The builder's working memory for one primitive (48 bytes; not needed after the build).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Scratch {
@@ -198,22 +166,106 @@ pub struct Scratch {
 pub struct Sizes {
     /// [`Node`]s.
     pub nodes: usize,
-    /// Leaves ([`Tri4`] or [`Sphere4`]).
+    /// Leaves ([`Tri4`], [`Sphere4`] or [`Inst4`]).
     pub leaves: usize,
     /// [`Scratch`] entries.
     pub scratch: usize,
 }
 
-/// The storage a tree over `n` primitives needs: `max(n/4, 1)` nodes, `n` leaves, `n` scratch
-/// entries.
-///
-/// The nodes' bound: a node stops splitting before [`WIDTH`] children only when every child
-/// is a leaf, so a node with an inner child has 8 children. Of the `I = F + B` inner nodes,
-/// the `B` without inner children hold disjoint ranges of more than [`LEAF_WIDTH`]
-/// primitives (`B ≤ n/5`), and the `F` others have `8F − (I − 1)` leaf children of at least
-/// one primitive each: `n ≥ 7F + 4B + 1`, so `I ≤ (n − 1 + 3B)/7 ≤ (8n − 5)/35 < n/4`.
-#[must_use]
-pub const fn needed(n: usize) -> Sizes {
+/// Why a build failed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BuildError {
+    /// Fewer nodes than [`Bvh::needed`] gives.
+    Nodes(TooSmall),
+    /// Fewer leaves than [`Bvh::needed`] gives.
+    Leaves(TooSmall),
+    /// Less scratch than [`Bvh::needed`] gives.
+    Scratch(TooSmall),
+    /// More than [`MAX_PRIMITIVES`].
+    TooMany,
+    /// [`Bvh::refit`]: the leaves do not hold the primitives (an index out of range, or a
+    /// different number of primitives than the build's).
+    Mismatch,
+}
+
+impl core::fmt::Display for BuildError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            BuildError::Nodes(t) => write!(f, "BVH build needs {} nodes", t.needed),
+            BuildError::Leaves(t) => write!(f, "BVH build needs {} leaves", t.needed),
+            BuildError::Scratch(t) => write!(f, "BVH build needs {} scratch entries", t.needed),
+            BuildError::TooMany => write!(f, "BVH build: more than 2^30 - 1 primitives"),
+            BuildError::Mismatch => write!(f, "BVH refit: leaves do not match the primitives"),
+        }
+    }
+}
+
+/// A built hierarchy: nodes of layout `N` and leaves `P`, borrowed from the caller.
+#[derive(Clone, Copy, Debug)]
+pub struct Bvh<'s, P: Packed, N: Layout = Node> {
+    pub(crate) nodes: &'s [N],
+    pub(crate) leaves: &'s [P],
+    /// The largest coordinate magnitude of the root's children (`R` in the margin).
+    pub(crate) reach: f32,
+}
+
+/// A BVH over triangles ([`Watertight`](crate::triangle::Watertight) by default).
+pub type TriangleBvh<'s> = Bvh<'s, Tri4>;
+/// A BVH over spheres ([`Robust`](crate::sphere::Robust) by default).
+pub type SphereBvh<'s> = Bvh<'s, Sphere4>;
+
+impl<'s, P: Packed> Bvh<'s, P, Node> {
+    /// The storage a tree over `n` primitives needs: `max(n/4, 1)` nodes, `n` leaves and `n`
+    /// scratch entries (`TriangleBvh::needed(n)`, `SphereBvh::needed(n)`).
+    ///
+    /// The nodes' bound: a node stops splitting before [`WIDTH`] children only when every child
+    /// is a leaf, so a node with an inner child has 8 children. Of the `I = F + B` inner nodes,
+    /// the `B` without inner children hold disjoint ranges of more than [`LEAF_WIDTH`]
+    /// primitives (`B ≤ n/5`), and the `F` others have `8F − (I − 1)` leaf children of at least
+    /// one primitive each: `n ≥ 7F + 4B + 1`, so `I ≤ (n − 1 + 3B)/7 ≤ (8n − 5)/35 < n/4`.
+    #[must_use]
+    pub const fn needed(n: usize) -> Sizes {
+        sizes(n)
+    }
+
+    /// Builds a tree over `prims` into `nodes`, `leaves` (sizes from [`needed`](Self::needed))
+    /// using `scratch` as working memory. See the [module docs](self) for the algorithm.
+    ///
+    /// # Errors
+    ///
+    /// [`BuildError`] when a slice is shorter than [`needed`](Self::needed) gives, or for more
+    /// than [`MAX_PRIMITIVES`].
+    pub fn build<Q: Primitives<Leaf = P> + ?Sized>(
+        prims: &Q,
+        nodes: &'s mut [Node],
+        leaves: &'s mut [P],
+        scratch: &mut [Scratch],
+    ) -> Result<Self, BuildError> {
+        build::build(prims, nodes, leaves, scratch)
+    }
+
+    /// Rewrites the leaves from `prims` (same indices, new coordinates) and recomputes every
+    /// box, children before parents. `nodes` and `leaves` must be the slices a build over a set
+    /// of the same size returned ([`Bvh::nodes`], [`Bvh::leaves`]). The topology stays the
+    /// build's: after large moves a rebuild gives a cheaper tree, but the answers are exact
+    /// either way.
+    ///
+    /// # Errors
+    ///
+    /// [`BuildError::Mismatch`] when `prims` has a different number of primitives than the
+    /// leaves hold, a leaf holds an index past it, or a child index is out of range (nothing
+    /// is then guaranteed about the slices' boxes).
+    pub fn refit<Q: Primitives<Leaf = P> + ?Sized>(
+        prims: &Q,
+        nodes: &'s mut [Node],
+        leaves: &'s mut [P],
+    ) -> Result<Self, BuildError> {
+        build::refit(prims, nodes, leaves)
+    }
+}
+
+/// [`Bvh::needed`] for `n` primitives.
+pub(crate) const fn sizes(n: usize) -> Sizes {
     Sizes {
         nodes: if n < 4 { 1 } else { n / 4 },
         leaves: n,
@@ -221,60 +273,17 @@ pub const fn needed(n: usize) -> Sizes {
     }
 }
 
-/// Why a build failed.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BuildError {
-    /// Fewer nodes than [`needed`] gives (the value is the number needed).
-    Nodes(usize),
-    /// Fewer leaves than [`needed`] gives.
-    Leaves(usize),
-    /// Less scratch than [`needed`] gives.
-    Scratch(usize),
-    /// More than [`MAX_PRIMITIVES`].
-    TooMany,
-    /// [`refit`]: the leaves do not match the primitives (an index out of range).
-    Mismatch,
-}
-
-impl core::fmt::Display for BuildError {
-    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        match self {
-            BuildError::Nodes(n) => write!(f, "BVH build needs {n} nodes"),
-            BuildError::Leaves(n) => write!(f, "BVH build needs {n} leaves"),
-            BuildError::Scratch(n) => write!(f, "BVH build needs {n} scratch entries"),
-            BuildError::TooMany => write!(f, "BVH build: more than 2^30 - 1 primitives"),
-            BuildError::Mismatch => write!(f, "BVH refit: leaves do not match the primitives"),
-        }
-    }
-}
-
-/// A built hierarchy: nodes and leaves borrowed from the caller.
-#[derive(Clone, Copy, Debug)]
-pub struct Bvh<'s, P: Packed> {
-    pub(crate) nodes: &'s [Node],
-    pub(crate) leaves: &'s [P],
-    /// The largest coordinate magnitude of the root's children (`R` in the margin).
-    pub(crate) reach: f32,
-    pub(crate) cull: Cull,
-}
-
-/// A BVH over triangles ([`Watertight`](crate::triangle::Watertight) kernel).
-pub type TriangleBvh<'s> = Bvh<'s, Tri4>;
-/// A BVH over spheres ([`Robust`](crate::sphere::Robust) kernel).
-pub type SphereBvh<'s> = Bvh<'s, Sphere4>;
-
-impl<'s, P: Packed> Bvh<'s, P> {
+impl<'s, P: Packed, N: Layout> Bvh<'s, P, N> {
     /// Reopens a tree from its two slices (e.g. `static` data built on a host). Returns `None`
-    /// when the slices are not a tree as [`build`] makes them: no nodes, a child index out of
+    /// when the slices are not a tree as a build makes them: no nodes, a child index out of
     /// range, an inner child not after its parent, a node reached twice, or a depth above
     /// [`MAX_DEPTH`] (linear in the number of nodes).
     #[must_use]
-    pub fn from_parts(nodes: &'s [Node], leaves: &'s [P]) -> Option<Self> {
-        if nodes.is_empty() {
-            return None;
-        }
+    pub fn from_parts(nodes: &'s [N], leaves: &'s [P]) -> Option<Self> {
+        let root = nodes.first()?;
         for (i, n) in nodes.iter().enumerate() {
-            for &c in &n.child {
+            for k in 0..WIDTH {
+                let c = n.child(k);
                 let ok = if c == EMPTY {
                     true
                 } else if c & LEAF != 0 {
@@ -291,20 +300,13 @@ impl<'s, P: Packed> Bvh<'s, P> {
         Some(Bvh {
             nodes,
             leaves,
-            reach: reach(&nodes[0]),
-            cull: Cull::None,
+            reach: reach(root),
         })
-    }
-
-    /// The same tree with back faces culled or not (triangles; spheres ignore it).
-    #[must_use]
-    pub fn with_cull(self, cull: Cull) -> Self {
-        Bvh { cull, ..self }
     }
 
     /// The nodes (root first).
     #[must_use]
-    pub fn nodes(&self) -> &'s [Node] {
+    pub fn nodes(&self) -> &'s [N] {
         self.nodes
     }
 
@@ -314,31 +316,40 @@ impl<'s, P: Packed> Bvh<'s, P> {
         self.leaves
     }
 
+    /// The box of the root (the union of its children's boxes).
+    #[must_use]
+    pub fn root_box(&self) -> ([f32; 3], [f32; 3]) {
+        let mut lo = [f32::INFINITY; 3];
+        let mut hi = [f32::NEG_INFINITY; 3];
+        if let Some(n) = self.nodes.first() {
+            for k in 0..WIDTH {
+                if n.child(k) == EMPTY {
+                    continue;
+                }
+                let (l, h) = n.bounds(k);
+                for a in 0..3 {
+                    lo[a] = min(lo[a], l[a]);
+                    hi[a] = max(hi[a], h[a]);
+                }
+            }
+        }
+        (lo, hi)
+    }
+
     /// Depth, node and leaf counts and SAH cost of the tree (walks every node).
     #[must_use]
     pub fn stats(&self) -> Stats {
-        let root_area = {
-            let n = &self.nodes[0];
-            let mut lo = [f32::INFINITY; 3];
-            let mut hi = [f32::NEG_INFINITY; 3];
-            for k in 0..WIDTH {
-                for a in 0..3 {
-                    lo[a] = min(lo[a], n.bounds[a][k]);
-                    hi[a] = max(hi[a], n.bounds[3 + a][k]);
-                }
-            }
-            area(lo, hi) as f64
-        };
+        let (lo, hi) = self.root_box();
+        let root_area = area(lo, hi) as f64;
         let mut sah = 1.0f64; // the root's traversal
         let mut prims = 0usize;
         for n in self.nodes {
             for k in 0..WIDTH {
-                let c = n.child[k];
+                let c = n.child(k);
                 if c == EMPTY {
                     continue;
                 }
-                let lo = [n.bounds[0][k], n.bounds[1][k], n.bounds[2][k]];
-                let hi = [n.bounds[3][k], n.bounds[4][k], n.bounds[5][k]];
+                let (lo, hi) = n.bounds(k);
                 let rel = if root_area > 0.0 {
                     area(lo, hi) as f64 / root_area
                 } else {
@@ -371,7 +382,7 @@ impl<'s, P: Packed> Bvh<'s, P> {
 /// The depth of the tree under `nodes[0]` (the root alone is 1), or `None` when a node is
 /// reached twice (more visits than nodes), the depth exceeds [`MAX_DEPTH`], or an inner
 /// child does not follow its parent.
-fn depth(nodes: &[Node]) -> Option<u32> {
+fn depth<N: Layout>(nodes: &[N]) -> Option<u32> {
     let mut stack = [(0u32, 1u32); STACK];
     let (mut sp, mut visits, mut deepest) = (1usize, 0usize, 0u32);
     while sp > 0 {
@@ -382,7 +393,9 @@ fn depth(nodes: &[Node]) -> Option<u32> {
             return None;
         }
         deepest = deepest.max(d);
-        for &c in &nodes.get(i as usize)?.child {
+        let n = nodes.get(i as usize)?;
+        for k in 0..WIDTH {
+            let c = n.child(k);
             if c != EMPTY && c & LEAF == 0 {
                 if c <= i {
                     return None;
@@ -413,6 +426,140 @@ pub struct Stats {
     pub bytes: usize,
 }
 
+/// A BVH answers as the flat set it was built over, with the same kernel and culling: the
+/// same closest [`Hit`](crate::Hit) bit for bit (see the [module docs](self)), for one ray
+/// (children in `f32x8` lanes, leaves in `f32x4` lanes: 1 ray × 4 primitives) and for packets
+/// of every width (N rays × 1 primitive in the leaves); `any` agrees; `all` reports each hit
+/// primitive's records as the flat set does, in traversal order.
+impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
+    type Prim = P::Prim;
+    type Kernel = P::Kernel;
+
+    #[inline]
+    fn trace_with<K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        let rays = admit(rays, K::UNIT_DIRECTIONS);
+        let pre = K::prepare(&rays);
+        traverse::many(self.nodes, self.reach, &rays, c, |li, r, c| {
+            leaf_many::<P, K, L, C>(self.leaves, li, &rays, r, &pre, cull, set, c)
+        })
+    }
+
+    #[inline]
+    fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
+        &self,
+        cull: Cull,
+        ray: &Ray,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        if C::EVERY {
+            return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
+        }
+        if K::UNIT_DIRECTIONS && (ray.dir().length_squared() - 1.0).abs() > UNIT_TOLERANCE {
+            return false;
+        }
+        let r4 = RayPacket::<f32x4>::splat(ray);
+        // The kernel's per-ray set-up (Watertight: the shear, 3 divisions), made at the first
+        // leaf: most rays that leave a surface reach none.
+        let mut pre = None;
+        traverse::one(self.nodes, self.reach, ray, c, |li, c| {
+            let Some(leaf) = self.leaves.get(li as usize) else {
+                return false;
+            };
+            let r = RayPacket {
+                t_max: f32x4::splat(c.t_max()),
+                ..r4
+            };
+            let pre = pre.get_or_insert_with(|| K::prepare(&r4));
+            let h = K::first(&r, pre, &leaf.four(), cull);
+            let mut bits = h.mask.bits();
+            while bits != 0 {
+                let j = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                let one = LaneHit {
+                    t: h.t.lane(j),
+                    u: h.u.lane(j),
+                    v: h.v.lane(j),
+                    w: h.w.lane(j),
+                    mask: true,
+                };
+                let at = At {
+                    set,
+                    index: leaf.indices()[j],
+                    loc: li * LEAF_WIDTH as u32 + j as u32,
+                };
+                if c.offer(&one, at, |_| Hits::miss()) {
+                    return true;
+                }
+            }
+            false
+        })
+    }
+
+    #[inline]
+    fn records_with<L: Lane>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        w: &Winners<L>,
+    ) -> Hits<L> {
+        P::Prim::records(rays, &mine(w, set), cull, |i| {
+            let loc = w.loc(i)? as usize;
+            Some(self.leaves.get(loc / LEAF_WIDTH)?.prim(loc % LEAF_WIDTH))
+        })
+    }
+}
+
+/// The primitives of leaf `li` against a packet: N rays × 1 primitive per lane of the leaf,
+/// in order, each offered to `c`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn leaf_many<P: Leaf, K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
+    leaves: &[P],
+    li: u32,
+    rays: &RayPacket<L>,
+    r: &RayPacket<L>,
+    pre: &K::Rays<L>,
+    cull: Cull,
+    set: u32,
+    c: &mut C,
+) -> bool {
+    let Some(leaf) = leaves.get(li as usize) else {
+        return false;
+    };
+    let mut r = *r;
+    for (k, &index) in leaf.indices().iter().enumerate() {
+        if index == EMPTY {
+            continue;
+        }
+        r.t_max = c.t_max();
+        let p = leaf.splat::<L>(k);
+        let at = At {
+            set,
+            index,
+            loc: li * LEAF_WIDTH as u32 + k as u32,
+        };
+        let record = |w: &Winners<L>| P::Prim::records(rays, w, cull, |_| Some(leaf.prim(k)));
+        let stop = if C::EVERY {
+            K::each(&r, pre, &p, cull, |h| c.offer(h, at, record))
+        } else {
+            let h = K::first(&r, pre, &p, cull);
+            h.mask.any() && c.offer(&h, at, record)
+        };
+        if stop {
+            return true;
+        }
+    }
+    false
+}
+
 /// `a < b ? a : b` (NaN in `b` ignored).
 #[inline(always)]
 pub(crate) fn min(a: f32, b: f32) -> f32 {
@@ -438,14 +585,15 @@ pub(crate) fn area(lo: [f32; 3], hi: [f32; 3]) -> f32 {
 
 /// The largest finite coordinate magnitude of a node's non-empty children (`+inf` when a box
 /// has an infinite coordinate, which sends every ray to the visit-all path).
-pub(crate) fn reach(n: &Node) -> f32 {
+pub(crate) fn reach<N: Layout>(n: &N) -> f32 {
     let mut r = 0.0f32;
     for k in 0..WIDTH {
-        if n.child[k] == EMPTY {
+        if n.child(k) == EMPTY {
             continue;
         }
-        for a in 0..6 {
-            r = max(r, n.bounds[a][k].abs());
+        let (lo, hi) = n.bounds(k);
+        for x in lo.into_iter().chain(hi) {
+            r = max(r, x.abs());
         }
     }
     r

@@ -24,15 +24,15 @@
 use glam::Vec3;
 
 use super::leaf::points_box;
-use super::traverse::{Slab, Stack};
 use super::{
-    BuildError, Bvh, EMPTY, LEAF, LEAF_WIDTH, Leaf, Node, Packed, Primitives, STACK, Scratch,
-    WIDTH, build, max, min,
+    BuildError, Bvh, EMPTY, LEAF_WIDTH, Layout, Leaf, Node, Packed, Primitives, Scratch, Sizes,
+    max, sizes, traverse,
 };
-use crate::hit::relax;
-use crate::lane::{Lane, Mask};
-use crate::query::{Hit, Hits, Query};
+use crate::hit::{Collector, Hit, Hits, Winners};
+use crate::kernel::{Cull, Kernel};
+use crate::lane::{Lane, Mask, Scalar};
 use crate::ray::{Ray, RayPacket};
+use crate::set::{Set, owned};
 use crate::vec3::V3;
 
 /// An object placed in the world: the object's index and its object→world affine transform.
@@ -108,6 +108,24 @@ impl Instance {
         )
     }
 
+    /// The world rays of a packet in object space, lane by lane as
+    /// [`ray_to_object`](Self::ray_to_object) (the same operations, so the same bits), over
+    /// the same intervals.
+    #[must_use]
+    pub fn packet_to_object<L: Lane>(&self, rays: &RayPacket<L>) -> RayPacket<L> {
+        let m = &self.to_object;
+        let (o, d) = (rays.origin, rays.dir);
+        let c = |x: f32| L::from_f32(x);
+        let p = |r: usize| ((c(m[r][0]) * o.x + c(m[r][1]) * o.y) + c(m[r][2]) * o.z) + c(m[r][3]);
+        let v = |r: usize| (c(m[r][0]) * d.x + c(m[r][1]) * d.y) + c(m[r][2]) * d.z;
+        RayPacket::new(
+            V3::new(p(0), p(1), p(2)),
+            V3::new(v(0), v(1), v(2)),
+            rays.t_min,
+            rays.t_max,
+        )
+    }
+
     /// The world box of an object box (empty in, empty out; infinite when not invertible).
     fn world_box(&self, lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
         if !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]) {
@@ -170,31 +188,13 @@ impl Packed for Inst4 {
     }
 }
 
-/// The box of a tree's root (the union of its children's boxes).
-fn root_box<P: Packed>(t: &Bvh<P>) -> ([f32; 3], [f32; 3]) {
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    if let Some(n) = t.nodes.first() {
-        for k in 0..WIDTH {
-            if n.child[k] == EMPTY {
-                continue;
-            }
-            for a in 0..3 {
-                lo[a] = min(lo[a], n.bounds[a][k]);
-                hi[a] = max(hi[a], n.bounds[3 + a][k]);
-            }
-        }
-    }
-    (lo, hi)
-}
-
 /// Instances over objects, as primitives for the top-level build.
-struct Placed<'a, 's, P: Packed> {
-    objects: &'a [Bvh<'s, P>],
+struct Placed<'a, 's, P: Packed, N: Layout> {
+    objects: &'a [Bvh<'s, P, N>],
     instances: &'a [Instance],
 }
 
-impl<P: Packed> Primitives for Placed<'_, '_, P> {
+impl<P: Packed, N: Layout> Primitives for Placed<'_, '_, P, N> {
     type Leaf = Inst4;
     fn count(&self) -> usize {
         self.instances.len()
@@ -205,7 +205,7 @@ impl<P: Packed> Primitives for Placed<'_, '_, P> {
         };
         match self.objects.get(inst.object as usize) {
             Some(o) => {
-                let (lo, hi) = root_box(o);
+                let (lo, hi) = o.root_box();
                 inst.world_box(lo, hi)
             }
             None => ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
@@ -223,28 +223,33 @@ impl<P: Packed> Primitives for Placed<'_, '_, P> {
 
 /// A scene: instances of objects under a top-level BVH (see the [module docs](self)).
 #[derive(Clone, Copy, Debug)]
-pub struct Scene<'s, P: Leaf> {
+pub struct Scene<'s, P: Leaf, N: Layout = Node> {
     top: Bvh<'s, Inst4>,
-    objects: &'s [Bvh<'s, P>],
+    objects: &'s [Bvh<'s, P, N>],
     instances: &'s [Instance],
 }
 
-impl<'s, P: Leaf> Scene<'s, P> {
+impl<'s, P: Leaf, N: Layout> Scene<'s, P, N> {
+    /// The storage the top level over `n` instances needs (leaves of [`Inst4`]).
+    #[must_use]
+    pub const fn needed(n: usize) -> Sizes {
+        sizes(n)
+    }
+
     /// Builds the top level over `instances` of `objects` into caller storage (sizes from
-    /// [`needed`](super::needed)`(instances.len())`, leaves of [`Inst4`]). An instance of a
-    /// missing object is never hit.
+    /// [`needed`](Self::needed)). An instance of a missing object is never hit.
     ///
     /// # Errors
     ///
-    /// As [`build`].
+    /// As [`Bvh::build`].
     pub fn build(
-        objects: &'s [Bvh<'s, P>],
+        objects: &'s [Bvh<'s, P, N>],
         instances: &'s [Instance],
         nodes: &'s mut [Node],
         leaves: &'s mut [Inst4],
         scratch: &mut [Scratch],
     ) -> Result<Self, BuildError> {
-        let top = build(&Placed { objects, instances }, nodes, leaves, scratch)?;
+        let top = Bvh::build(&Placed { objects, instances }, nodes, leaves, scratch)?;
         Ok(Scene {
             top,
             objects,
@@ -258,58 +263,15 @@ impl<'s, P: Leaf> Scene<'s, P> {
         &self.top
     }
 
-    /// The closest hit of one world ray (see the [module docs](self)).
-    fn closest_one(&self, ray: &Ray) -> Option<Hit> {
-        if !ray.is_valid() {
-            return None;
-        }
-        let slab = Slab::new(ray.origin(), ray.dir(), self.top.reach);
-        let t_end = ray.t_max();
-        let mut t_max = relax(t_end);
-        let mut best: Option<Hit> = None;
-        let mut stack = Stack::<STACK>::new();
-        while let Some((c, tn)) = stack.pop() {
-            if tn > t_max {
-                continue;
-            }
-            if c & LEAF == 0 {
-                if let Some(n) = self.top.nodes.get(c as usize) {
-                    let (bits, tn) = slab.test(n, ray.t_min(), t_max);
-                    stack.push_sorted(n, bits, &tn.to_array());
-                }
-                continue;
-            }
-            let Some(leaf) = self.top.leaves.get((c & !LEAF) as usize) else {
-                continue;
-            };
-            for &i in leaf.indices() {
-                let Some(h) = self.instance_hit(i, &ray.with_t_max(t_max)) else {
-                    continue;
-                };
-                let closer = match &best {
-                    None => true,
-                    Some(b) => h.t < b.t || (h.t == b.t && h.set < b.set),
-                };
-                if h.t < t_end && closer {
-                    t_max = relax(h.t);
-                    best = Some(h);
-                }
-            }
-        }
-        best
-    }
-
-    /// Instance `i`'s closest hit of the world ray, as a world record.
-    fn instance_hit(&self, i: u32, ray: &Ray) -> Option<Hit> {
+    /// Instance `i` and its object.
+    #[inline(always)]
+    fn placed(&self, i: u32) -> Option<(&Instance, &Bvh<'s, P, N>)> {
         let inst = self.instances.get(i as usize)?;
-        let object = self.objects.get(inst.object as usize)?;
-        let local = inst.ray_to_object(ray);
-        let h = object.closest(&local)?;
-        Some(self.world_record(inst, i, ray, h))
+        Some((inst, self.objects.get(inst.object as usize)?))
     }
 
     /// An object record in world space: point on the world ray, normal `Mᵀ·n` normalised.
-    fn world_record(&self, inst: &Instance, i: u32, ray: &Ray, h: Hit) -> Hit {
+    fn world_record(inst: &Instance, i: u32, ray: &Ray, h: Hit) -> Hit {
         let m = &inst.to_object;
         let n = h.normal;
         let w = |c: usize| (m[0][c] * n.x + m[1][c] * n.y) + m[2][c] * n.z;
@@ -330,137 +292,126 @@ impl<'s, P: Leaf> Scene<'s, P> {
     }
 }
 
-/// A scene answers like its instances queried one by one (see the [module docs](self)).
-/// Packets are answered lane by lane through the one-ray path (every lane equals it); `any`
-/// stops at the first hit; `all` reports, per lane, every instance's hits in top-level
-/// traversal order.
-impl<P: Leaf> Query for Scene<'_, P> {
-    fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
+/// A scene answers like its instances queried one by one with the same kernel and culling:
+/// the smallest `t`, ties to the lower instance, then the lower primitive. The top level is a
+/// BVH whose leaves are instances, traversed by the one traversal: a leaf moves the rays into
+/// the object's space and traverses the object, offering its hits to the same collector (so
+/// `any` stops at the first occluder). `set` in the records is the instance.
+impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
+    type Prim = P::Prim;
+    type Kernel = P::Kernel;
+
+    #[inline]
+    fn sets(&self) -> u32 {
+        self.instances.len() as u32
+    }
+
+    fn trace_with<K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        traverse::many(self.top.nodes, self.top.reach, rays, c, |li, r, c| {
+            let Some(leaf) = self.top.leaves.get(li as usize) else {
+                return false;
+            };
+            for &i in leaf.indices() {
+                let Some((inst, object)) = self.placed(i) else {
+                    continue;
+                };
+                let local = inst.packet_to_object(r);
+                if object.trace_with::<K, L, C>(cull, &local, set + i, c) {
+                    return true;
+                }
+            }
+            false
+        })
+    }
+
+    fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
+        &self,
+        cull: Cull,
+        ray: &Ray,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        if C::EVERY {
+            return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
+        }
+        traverse::one(self.top.nodes, self.top.reach, ray, c, |li, c| {
+            let Some(leaf) = self.top.leaves.get(li as usize) else {
+                return false;
+            };
+            for &i in leaf.indices() {
+                let Some((inst, object)) = self.placed(i) else {
+                    continue;
+                };
+                let local = inst.ray_to_object(ray);
+                if object.trace_ray_with::<K, C>(cull, &local, set + i, c) {
+                    return true;
+                }
+            }
+            false
+        })
+    }
+
+    fn records_with<L: Lane>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        w: &Winners<L>,
+    ) -> Hits<L> {
+        let w = owned(w, set, self.sets());
         let mut out = Hits::<L>::miss();
-        for j in 0..L::LANES {
-            if let Some(h) = lane_ray(rays, j).and_then(|r| self.closest_one(&r)) {
-                put_lane_generic(&mut out, j, &h);
+        let mut bits = w.mask.bits();
+        while bits != 0 {
+            let j = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let Some(ray) = lane_ray(rays, j) else {
+                continue;
+            };
+            let i = w.set.as_ref()[j] - set;
+            let Some((inst, object)) = self.placed(i) else {
+                continue;
+            };
+            let local = inst.ray_to_object(&ray);
+            let one = Winners::<f32> {
+                t: lane(w.t, j),
+                u: lane(w.u, j),
+                v: lane(w.v, j),
+                index: [w.index.as_ref()[j]],
+                set: [0],
+                loc: [w.loc.as_ref()[j]],
+                mask: true,
+            };
+            let h = object
+                .records_with(cull, &RayPacket::splat(&local), 0, &one)
+                .lane(0);
+            if let Some(h) = h {
+                out.set_lane(j, Some(&Self::world_record(inst, set + i, &ray, h)));
             }
         }
         out
     }
-
-    fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
-        let mut m = L::Mask::splat(false);
-        for j in 0..L::LANES {
-            if lane_ray(rays, j).is_some_and(|r| self.any_ray(&r)) {
-                m = m.with_lane(j, true);
-            }
-        }
-        m
-    }
-
-    fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
-        for j in 0..L::LANES {
-            let Some(r) = lane_ray(rays, j) else { continue };
-            self.each_instance(&r, &mut |inst, i, local| {
-                object_all(self, inst, i, &r, local, &mut |h: &Hit| {
-                    let mut out = Hits::<L>::miss();
-                    put_lane_generic(&mut out, j, h);
-                    f(&out);
-                });
-            });
-        }
-    }
-
-    fn closest_ray(&self, ray: &Ray) -> Option<Hit> {
-        self.closest_one(ray)
-    }
-
-    fn any_ray(&self, ray: &Ray) -> bool {
-        let mut hit = false;
-        self.each_instance(ray, &mut |inst, _, local| {
-            if !hit {
-                hit = self
-                    .objects
-                    .get(inst.object as usize)
-                    .is_some_and(|o| o.any(local));
-            }
-        });
-        hit
-    }
 }
 
-impl<P: Leaf> Scene<'_, P> {
-    /// Calls `f(instance, index, object ray)` for every instance whose top-level box the ray
-    /// enters (interval not shrunk).
-    fn each_instance(&self, ray: &Ray, f: &mut dyn FnMut(&Instance, u32, &Ray)) {
-        if !ray.is_valid() {
-            return;
-        }
-        let slab = Slab::new(ray.origin(), ray.dir(), self.top.reach);
-        let mut stack = Stack::<STACK>::new();
-        while let Some((c, _)) = stack.pop() {
-            if c & LEAF == 0 {
-                if let Some(n) = self.top.nodes.get(c as usize) {
-                    let (bits, tn) = slab.test(n, ray.t_min(), ray.t_max());
-                    stack.push_sorted(n, bits, &tn.to_array());
-                }
-                continue;
-            }
-            let Some(leaf) = self.top.leaves.get((c & !LEAF) as usize) else {
-                continue;
-            };
-            for &i in leaf.indices() {
-                if let Some(inst) = self.instances.get(i as usize) {
-                    f(inst, i, &inst.ray_to_object(ray));
-                }
-            }
-        }
-    }
-}
-
-/// Every hit of one instance's object, as world records.
-fn object_all<P: Leaf>(
-    scene: &Scene<P>,
-    inst: &Instance,
-    i: u32,
-    ray: &Ray,
-    local: &Ray,
-    f: &mut dyn FnMut(&Hit),
-) {
-    if let Some(o) = scene.objects.get(inst.object as usize) {
-        o.all(local, |h| f(&scene.world_record(inst, i, ray, h)));
-    }
+/// Lane `j` as an `f32`.
+#[inline(always)]
+fn lane<L: Lane>(x: L, j: usize) -> f32 {
+    x.lane(j).to_f64() as f32
 }
 
 /// Lane `j` of a packet as a scalar ray (`None` for an empty interval).
 fn lane_ray<L: Lane>(rays: &RayPacket<L>, j: usize) -> Option<Ray> {
-    use crate::lane::Scalar;
-    let f = |x: L| x.lane(j).to_f64() as f32;
-    let v = |v: V3<L>| Vec3::new(f(v.x), f(v.y), f(v.z));
-    let r = Ray::with_interval(v(rays.origin), v(rays.dir), f(rays.t_min), f(rays.t_max));
+    let v = |v: V3<L>| Vec3::new(lane(v.x, j), lane(v.y, j), lane(v.z, j));
+    let r = Ray::with_interval(
+        v(rays.origin),
+        v(rays.dir),
+        lane(rays.t_min, j),
+        lane(rays.t_max, j),
+    );
     r.is_valid().then_some(r)
-}
-
-/// Writes one ray's record into lane `j` of a packet record.
-fn put_lane_generic<L: Lane>(out: &mut Hits<L>, j: usize, h: &Hit) {
-    use crate::lane::Scalar;
-    let s = |x: f32| L::Scalar::from_f32(x);
-    out.t = out.t.with_lane(j, s(h.t));
-    out.point = V3::new(
-        out.point.x.with_lane(j, s(h.point.x)),
-        out.point.y.with_lane(j, s(h.point.y)),
-        out.point.z.with_lane(j, s(h.point.z)),
-    );
-    out.normal = V3::new(
-        out.normal.x.with_lane(j, s(h.normal.x)),
-        out.normal.y.with_lane(j, s(h.normal.y)),
-        out.normal.z.with_lane(j, s(h.normal.z)),
-    );
-    out.front = out.front.with_lane(j, h.front);
-    out.u = out.u.with_lane(j, s(h.u));
-    out.v = out.v.with_lane(j, s(h.v));
-    out.mask = out.mask.with_lane(j, true);
-    if let Some(x) = out.index.as_mut().get_mut(j) {
-        *x = h.index;
-    }
-    if let Some(x) = out.set.as_mut().get_mut(j) {
-        *x = h.set;
-    }
 }

@@ -53,11 +53,8 @@
 use glam::Vec3;
 
 use super::{Roots, Sphere, SpherePacket};
-use crate::hit::{self, HitRecord};
 use crate::lane::{Lane, Mask};
-use crate::query::{self, Hits, Query, TooSmall, sphere_hit};
-use crate::ray::{Ray, RayPacket};
-use crate::triangle::Cull;
+use crate::ray::RayPacket;
 use crate::vec3::V3;
 
 /// Unit roundoff of f32.
@@ -334,7 +331,6 @@ impl<L: Lane> FocalSphere<L> {
 /// Where a focal kernel reads its cached sphere lanes from: a [`FocalSphere<L>`] already in
 /// lanes (1 ray × N spheres), or a [`Splat`] of one entry (N rays × 1 sphere) that broadcasts
 /// only what each step needs, so a miss touches `T` and `k_lo` alone.
-#[doc(hidden)]
 pub trait FocalLanes<L: Lane> {
     /// `T = C − E` in lanes.
     fn t(&self) -> V3<L>;
@@ -370,7 +366,6 @@ impl<L: Lane> FocalLanes<L> for FocalSphere<L> {
 
 /// One cache entry seen in every lane, broadcast lazily (see [`FocalLanes`]).
 #[derive(Clone, Copy, Debug)]
-#[doc(hidden)]
 pub struct Splat<'a>(pub &'a FocalSphere<f32>);
 
 impl<L: Lane> FocalLanes<L> for Splat<'_> {
@@ -403,7 +398,6 @@ impl<L: Lane> FocalLanes<L> for Splat<'_> {
 
 /// Builds the guarded cache of `spheres` for rays from `eye` into `out` (no allocation);
 /// returns the number of entries written (`min(spheres.len(), out.len())`).
-#[doc(hidden)]
 pub fn focus(eye: Vec3, spheres: &[Sphere], out: &mut [FocalSphere<f32>]) -> usize {
     let mut n = 0;
     for (s, slot) in spheres.iter().zip(out.iter_mut()) {
@@ -512,185 +506,5 @@ fn hit_path<L: Lane, S: FocalLanes<L>>(
         roots
     } else {
         super::precise(*ray, s.sphere(), roots, doubtful)
-    }
-}
-
-/// Closest hit of ray packets from the cache's eye over cached spheres (N rays × 1 sphere).
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn closest<K: FocalKernel, L: Lane>(
-    rays: &RayPacket<L>,
-    cache: &[FocalSphere<f32>],
-) -> hit::Best<L> {
-    hit::closest_filtered(
-        rays,
-        cache,
-        |r, e| K::candidate(r, &Splat(e)),
-        |r, e| K::maybe_roots(r, &Splat(e)).map(|r| r.first()),
-    )
-}
-
-/// Lanes whose ray hits some cached sphere (occlusion).
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn any<K: FocalKernel, L: Lane>(rays: &RayPacket<L>, cache: &[FocalSphere<f32>]) -> L::Mask {
-    hit::any_filtered(
-        rays,
-        cache,
-        |r, e| K::candidate(r, &Splat(e)),
-        |r, e| K::maybe_roots(r, &Splat(e)).map(|r| r.first()),
-    )
-}
-
-/// Every root of every cached sphere some lane hits: `f(index, roots)`.
-#[inline]
-#[doc(hidden)]
-pub fn all<K: FocalKernel, L: Lane>(
-    rays: &RayPacket<L>,
-    cache: &[FocalSphere<f32>],
-    mut f: impl FnMut(u32, &Roots<L>),
-) {
-    for (i, e) in cache.iter().enumerate() {
-        let r = K::roots(rays, &Splat(e));
-        if r.any().any() {
-            f(i as u32, &r);
-        }
-    }
-}
-
-/// Closest hit of one ray from the eye over cached spheres packed in lanes (1 ray × N).
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn closest_soa<K: FocalKernel, L: Lane>(
-    ray: &Ray,
-    cache: &[FocalSphere<L>],
-) -> Option<HitRecord> {
-    hit::closest_soa(ray, cache, |r, e| K::maybe_roots(r, e).map(|r| r.first()))
-}
-
-/// True when one ray from the eye hits some cached sphere packed in lanes.
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn any_soa<K: FocalKernel, L: Lane>(ray: &Ray, cache: &[FocalSphere<L>]) -> bool {
-    hit::any_soa(ray, cache, |r, e| K::maybe_roots(r, e).map(|r| r.first()))
-}
-
-/// A guarded sphere cache that owns its eye (see the [module docs](self)): through [`Query`]
-/// it answers rays that start exactly at the eye and have unit directions
-/// (`||d|² − 1| ≤ 2^-20`, as [`Ray::unit`](crate::Ray::unit) makes them); any other ray is a
-/// miss, never wrong roots.
-#[derive(Clone, Copy, Debug)]
-pub struct FocalSpheres<'c> {
-    eye: Vec3,
-    cache: &'c [FocalSphere<f32>],
-    cull: Cull,
-}
-
-impl<'c> FocalSpheres<'c> {
-    /// The number of entries [`focus`](Self::focus) needs for `spheres`: one per sphere.
-    #[inline]
-    #[must_use]
-    pub fn needed(spheres: &[Sphere]) -> usize {
-        spheres.len()
-    }
-
-    /// Builds the guarded entries of `spheres` for rays from `eye` into `out` (entry `i` for
-    /// sphere `i`); `out` shorter than [`needed`](Self::needed) is an error (nothing built).
-    pub fn focus(
-        eye: Vec3,
-        spheres: &[Sphere],
-        out: &'c mut [FocalSphere<f32>],
-    ) -> Result<Self, TooSmall> {
-        let needed = Self::needed(spheres);
-        let Some(out) = out.get_mut(..needed) else {
-            return Err(TooSmall { needed });
-        };
-        focus(eye, spheres, out);
-        Ok(FocalSpheres {
-            eye,
-            cache: out,
-            cull: Cull::None,
-        })
-    }
-
-    /// The eye.
-    #[inline]
-    #[must_use]
-    pub fn eye(&self) -> Vec3 {
-        self.eye
-    }
-
-    /// The entries.
-    #[inline]
-    #[must_use]
-    pub fn cache(&self) -> &'c [FocalSphere<f32>] {
-        self.cache
-    }
-
-    /// The same cache with [`Query`] calls culled ([`Cull::Back`]: entry roots only).
-    #[inline]
-    #[must_use]
-    pub fn culled(self, cull: Cull) -> Self {
-        FocalSpheres { cull, ..self }
-    }
-
-    /// The rays this cache answers (see the type's docs).
-    #[inline(always)]
-    fn admitted<L: Lane>(&self, rays: &RayPacket<L>) -> RayPacket<L> {
-        query::admit(&query::at_eye(rays, self.eye), true)
-    }
-
-    /// Sphere `i`, for the records.
-    fn sphere(&self, i: u32) -> Option<Sphere> {
-        let e = self.cache.get(i as usize)?;
-        Some(Sphere::new(e.center.into(), e.radius))
-    }
-}
-
-/// Guarded focal spheres ([`Focal`]): two passes per block (the cheap test first), in index
-/// order; `all` reports, per sphere in index order, its entry roots, then its exit roots.
-impl Query for FocalSpheres<'_> {
-    #[inline]
-    fn closest_packet<L: Lane>(&self, rays: &RayPacket<L>) -> Hits<L> {
-        let r = self.admitted(rays);
-        let cull = self.cull;
-        let best = hit::closest_filtered(
-            &r,
-            self.cache,
-            |r, e| Focal::candidate(r, &Splat(e)),
-            |r, e| Focal::maybe_roots(r, &Splat(e)).map(|x| sphere_hit(&x, cull)),
-        );
-        Hits::from_spheres(&r, &best, |i| self.sphere(i))
-    }
-
-    #[inline]
-    fn any_packet<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
-        let r = self.admitted(rays);
-        let cull = self.cull;
-        hit::any_filtered(
-            &r,
-            self.cache,
-            |r, e| Focal::candidate(r, &Splat(e)),
-            |r, e| Focal::maybe_roots(r, &Splat(e)).map(|x| sphere_hit(&x, cull)),
-        )
-    }
-
-    fn all_packet<L: Lane>(&self, rays: &RayPacket<L>, f: &mut dyn FnMut(&Hits<L>)) {
-        let r = self.admitted(rays);
-        for (i, e) in self.cache.iter().enumerate() {
-            let roots = Focal::roots(&r, &Splat(e));
-            query::each_root(
-                &r,
-                &roots,
-                self.cull,
-                i as u32,
-                &|_| self.sphere(i as u32),
-                f,
-            );
-        }
     }
 }

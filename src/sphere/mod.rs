@@ -64,9 +64,9 @@ pub use focal::FocalSphere;
 
 use glam::Vec3;
 
-use crate::hit::{self, HitRecord, LaneHit};
+use crate::kernel::{Cull, Kernel, LaneHit, Primitive};
 use crate::lane::{Lane, Mask, Scalar};
-use crate::ray::{Ray, RayPacket};
+use crate::ray::RayPacket;
 use crate::vec3::V3;
 
 /// A sphere: centre and radius.
@@ -234,8 +234,8 @@ impl<L: Lane> Roots<L> {
             t,
             u: zero,
             v: zero,
-            mask: self.m0 | self.m1,
             w: L::from_f32(1.0),
+            mask: self.m0 | self.m1,
         }
     }
 
@@ -463,69 +463,73 @@ fn precise_normals<L: Lane>(
     normal
 }
 
-/// Closest hit of one ray and one sphere with kernel `K`: the [`HitRecord`] of the nearest root
-/// inside the ray's interval (its `t`; `u = v = 0` for spheres), or `None` for a miss.
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn intersect<K: SphereKernel>(ray: &Ray, sphere: &Sphere) -> Option<HitRecord> {
-    K::roots(&RayPacket::<f32>::splat(ray), &SpherePacket::splat(sphere))
-        .first()
-        .record()
-}
-
-/// Closest hit of ray lanes over a slice of spheres with kernel `K` (N rays × 1 sphere).
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn closest<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) -> hit::Best<L> {
-    hit::closest(rays, spheres, |r, s| {
-        Some(K::roots(r, &SpherePacket::splat(s)).first())
-    })
-}
-
-/// Lanes whose ray hits some sphere (occlusion), with kernel `K`.
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn any<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, spheres: &[Sphere]) -> L::Mask {
-    hit::any(rays, spheres, |r, s| {
-        Some(K::roots(r, &SpherePacket::splat(s)).first())
-    })
-}
-
-/// Every root of every sphere: calls `f(index, roots)` for each sphere that some lane hits.
-#[inline]
-#[doc(hidden)]
-pub fn all<K: SphereKernel, L: Lane>(
-    rays: &RayPacket<L>,
-    spheres: &[Sphere],
-    mut f: impl FnMut(u32, &Roots<L>),
-) {
-    for (i, s) in spheres.iter().enumerate() {
-        let r = K::roots(rays, &SpherePacket::splat(s));
-        if r.any().any() {
-            f(i as u32, &r);
-        }
+impl Primitive for Sphere {
+    type Packet<L: Lane> = SpherePacket<L>;
+    #[inline(always)]
+    fn splat<L: Lane>(&self) -> SpherePacket<L> {
+        SpherePacket::splat(self)
     }
 }
 
-/// Closest hit of one ray over spheres packed in lanes (1 ray × N spheres); the index is the
-/// sphere's position in the slice that was packed.
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn closest_soa<K: SphereKernel, L: Lane>(
-    ray: &Ray,
-    spheres: &[SpherePacket<L>],
-) -> Option<HitRecord> {
-    hit::closest_soa(ray, spheres, |r, s| Some(K::roots(r, s).first()))
+/// Every sphere kernel is a [`Kernel`] of spheres: its first root inside the interval, with
+/// `u = 1` marking an exit root (the origin is inside: a back face) and `u = 0` an entry root;
+/// under [`Cull::Back`] only entry roots. [`each`](Kernel::each) gives the entry roots, then
+/// (unless culled) the exit roots.
+impl<K: SphereKernel> Kernel<Sphere> for K {
+    type Rays<L: Lane> = ();
+    const UNIT_DIRECTIONS: bool = K::UNIT_DIRECTIONS;
+
+    #[inline(always)]
+    fn prepare<L: Lane>(_: &RayPacket<L>) {}
+
+    #[inline(always)]
+    fn first<L: Lane>(rays: &RayPacket<L>, _: &(), s: &SpherePacket<L>, cull: Cull) -> LaneHit<L> {
+        first_root(&K::roots(rays, s), cull)
+    }
+
+    #[inline(always)]
+    fn each<L: Lane>(
+        rays: &RayPacket<L>,
+        _: &(),
+        s: &SpherePacket<L>,
+        cull: Cull,
+        f: impl FnMut(&LaneHit<L>) -> bool,
+    ) -> bool {
+        each_root(&K::roots(rays, s), cull, f)
+    }
 }
 
-/// True when one ray hits some sphere packed in lanes.
-#[inline]
+/// The first root of `roots` inside the interval, with `u = 1` marking an exit root and
+/// `u = 0` an entry root; under [`Cull::Back`] only entry roots.
+#[inline(always)]
 #[must_use]
-#[doc(hidden)]
-pub fn any_soa<K: SphereKernel, L: Lane>(ray: &Ray, spheres: &[SpherePacket<L>]) -> bool {
-    hit::any_soa(ray, spheres, |r, s| Some(K::roots(r, s).first()))
+pub fn first_root<L: Lane>(roots: &Roots<L>, cull: Cull) -> LaneHit<L> {
+    let zero = L::from_f32(0.0);
+    if cull.back() {
+        LaneHit::new(roots.t0, zero, zero, roots.m0)
+    } else {
+        let t = L::select(roots.m0, roots.t0, roots.t1);
+        let exit = L::select(roots.m0, zero, L::from_f32(1.0));
+        LaneHit::new(t, exit, zero, roots.m0 | roots.m1)
+    }
+}
+
+/// The entry roots, then (unless culled) the exit roots with `u = 1`, each passed to `f` when
+/// some lane has one; stops when `f` returns true, and returns whether it stopped.
+#[inline(always)]
+pub fn each_root<L: Lane>(
+    roots: &Roots<L>,
+    cull: Cull,
+    mut f: impl FnMut(&LaneHit<L>) -> bool,
+) -> bool {
+    let zero = L::from_f32(0.0);
+    let entry = LaneHit::new(roots.t0, zero, zero, roots.m0);
+    if entry.mask.any() && f(&entry) {
+        return true;
+    }
+    if cull.back() {
+        return false;
+    }
+    let exit = LaneHit::new(roots.t1, L::from_f32(1.0), zero, roots.m1);
+    exit.mask.any() && f(&exit)
 }

@@ -1,7 +1,7 @@
 //! The lecture's formulation: the 3×3 system solved by Cramer's rule (lecture 002).
 
 use super::{Cull, TriangleKernel, TrianglePacket};
-use crate::hit::LaneHit;
+use crate::kernel::LaneHit;
 use crate::lane::{Lane, Mask};
 use crate::ray::RayPacket;
 

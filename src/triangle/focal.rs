@@ -112,9 +112,9 @@ use glam::Vec3;
 
 use super::exact;
 use super::{Cull, Triangle, in_front, within};
-use crate::hit::{self, Best, HitRecord, LaneHit};
+use crate::kernel::LaneHit;
 use crate::lane::{Lane, Mask, Scalar};
-use crate::ray::{Ray, RayPacket};
+use crate::ray::RayPacket;
 use crate::vec3::V3;
 
 /// Unit roundoff of f32.
@@ -374,7 +374,6 @@ impl<L: Lane> FocalTriangle<L> {
 /// lanes (1 ray × N triangles), or a [`Splat`] of one entry (N rays × 1 triangle) that
 /// broadcasts only what each step needs, so a miss reads the edge normals and bounds alone and
 /// the exact fallback reads the scalar entry (no splatted copy of the whole entry is built).
-#[doc(hidden)]
 pub trait FocalTriangleLanes<L: Lane> {
     /// `n_ab`, `n_bc`, `n_ca` in lanes.
     fn normals(&self) -> (V3<L>, V3<L>, V3<L>);
@@ -420,7 +419,7 @@ impl<L: Lane> FocalTriangleLanes<L> for FocalTriangle<L> {
 
 /// One cache entry seen in every lane, broadcast lazily (see [`FocalTriangleLanes`]).
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct Splat<'a>(pub(crate) &'a FocalTriangle<f32>);
+pub struct Splat<'a>(pub &'a FocalTriangle<f32>);
 
 impl<L: Lane> FocalTriangleLanes<L> for Splat<'_> {
     #[inline(always)]
@@ -455,7 +454,6 @@ impl<L: Lane> FocalTriangleLanes<L> for Splat<'_> {
 
 /// Builds the cache of `tris` for rays from `eye` into `out` (no allocation); returns the
 /// number of entries written (`min(tris.len(), out.len())`).
-#[doc(hidden)]
 pub fn focus(eye: Vec3, tris: &[Triangle], out: &mut [FocalTriangle<f32>]) -> usize {
     let mut n = 0;
     for (t, slot) in tris.iter().zip(out.iter_mut()) {
@@ -470,7 +468,6 @@ pub fn focus(eye: Vec3, tris: &[Triangle], out: &mut [FocalTriangle<f32>]) -> us
 /// strictly inside it comes back as a finite `t·s` strictly inside the ray's own interval),
 /// and a unit direction for bounding spheres ([`FocalSphere`](crate::sphere::FocalSphere)).
 #[derive(Clone, Copy, Debug)]
-#[doc(hidden)]
 pub struct FocalRays<L: Lane> {
     pub(crate) scaled: RayPacket<L>,
     pub(crate) scale: L,
@@ -568,7 +565,6 @@ impl<L: Lane> FocalRays<L> {
     /// The scaled rays (the kernel's units).
     #[inline]
     #[must_use]
-    #[doc(hidden)]
     pub fn scaled(&self) -> &RayPacket<L> {
         &self.scaled
     }
@@ -599,10 +595,17 @@ impl<L: Lane> FocalRays<L> {
         }
     }
 
+    /// A `t` in the scaled units in the rays' own (1 mul, and 1 add for `+0`).
+    #[inline(always)]
+    #[must_use]
+    pub fn own_units(&self, t: L) -> L {
+        own_units(t, self.scale)
+    }
+
     /// Converts a hit from the scaled units to the rays' own (1 mul, and 1 add for `+0`).
     #[inline(always)]
     #[must_use]
-    pub(crate) fn unscale(&self, h: LaneHit<L>) -> LaneHit<L> {
+    pub fn unscale(&self, h: LaneHit<L>) -> LaneHit<L> {
         LaneHit {
             t: own_units(h.t, self.scale),
             ..h
@@ -622,7 +625,6 @@ fn own_units<L: Lane>(t: L, s: L) -> L {
 /// [module docs](self).
 #[inline(always)]
 #[must_use]
-#[doc(hidden)]
 pub fn kernel<L: Lane, F: FocalTriangleLanes<L>>(
     ray: &RayPacket<L>,
     f: &F,
@@ -799,117 +801,12 @@ fn exact_signs<L: Lane, F: FocalTriangleLanes<L>>(
 /// The hit of prepared ray lanes on cached triangle lanes, `t` in the rays' own units.
 #[inline(always)]
 #[must_use]
-#[doc(hidden)]
 pub fn intersect_lanes<L: Lane>(
     rays: &FocalRays<L>,
     tri: &FocalTriangle<L>,
     cull: Cull,
 ) -> LaneHit<L> {
     rays.unscale(kernel(&rays.scaled, tri, cull)).normalized()
-}
-
-/// The hit of one ray from the eye on one cached triangle, or `None`.
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn intersect(ray: &Ray, tri: &FocalTriangle<f32>, cull: Cull) -> Option<HitRecord> {
-    intersect_lanes(&FocalRays::new(&RayPacket::splat(ray)), tri, cull).record()
-}
-
-/// Closest hit of prepared rays over cached triangles (N rays × 1 triangle).
-#[inline]
-#[must_use]
-pub(crate) fn closest_prepared<L: Lane>(
-    rays: &FocalRays<L>,
-    cache: &[FocalTriangle<f32>],
-    cull: Cull,
-) -> Best<L> {
-    // Two passes, the cheap edge test over a block of triangles first.
-    let mut best = hit::closest_filtered(
-        &rays.scaled,
-        cache,
-        |r, e| candidate(r, &Splat(e), cull),
-        |r, e| maybe_hit(r, &Splat(e), cull),
-    );
-    best.t = own_units(best.t, rays.scale);
-    best
-}
-
-/// Closest hit of ray packets from the cache's eye over cached triangles (N rays × 1).
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn closest<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull: Cull) -> Best<L> {
-    closest_prepared(&FocalRays::new(rays), cache, cull)
-}
-
-/// Lanes whose ray hits some cached triangle (occlusion).
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn any<L: Lane>(rays: &RayPacket<L>, cache: &[FocalTriangle<f32>], cull: Cull) -> L::Mask {
-    let fr = FocalRays::new(rays);
-    hit::any(&fr.scaled, cache, |r, e| maybe_hit(r, &Splat(e), cull))
-}
-
-/// Every hit of prepared rays: `f(index, hit)` for each cached triangle some lane hits (`t` in
-/// the rays' own units).
-#[inline]
-pub(crate) fn all_prepared<L: Lane>(
-    rays: &FocalRays<L>,
-    cache: &[FocalTriangle<f32>],
-    cull: Cull,
-    mut f: impl FnMut(u32, &LaneHit<L>),
-) {
-    for (i, e) in cache.iter().enumerate() {
-        let h = kernel(&rays.scaled, &Splat(e), cull);
-        if h.mask.any() {
-            f(i as u32, &rays.unscale(h).normalized());
-        }
-    }
-}
-
-/// Every hit: `f(index, hit)` for each cached triangle some lane hits.
-#[inline]
-#[doc(hidden)]
-pub fn all<L: Lane>(
-    rays: &RayPacket<L>,
-    cache: &[FocalTriangle<f32>],
-    cull: Cull,
-    f: impl FnMut(u32, &LaneHit<L>),
-) {
-    all_prepared(&FocalRays::new(rays), cache, cull, f);
-}
-
-/// The scaled ray and its scale, for the one-ray entry points.
-fn scaled_ray(ray: &Ray) -> (Ray, f32) {
-    let fr = FocalRays::<f32>::new(&RayPacket::splat(ray));
-    (fr.scaled.ray(0), fr.scale)
-}
-
-/// Closest hit of one ray from the eye over cached triangles packed in lanes (1 ray × N).
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn closest_soa<L: Lane>(
-    ray: &Ray,
-    cache: &[FocalTriangle<L>],
-    cull: Cull,
-) -> Option<HitRecord> {
-    let (r, s) = scaled_ray(ray);
-    hit::closest_soa(&r, cache, |r, e| maybe_hit(r, e, cull)).map(|h| HitRecord {
-        t: own_units(h.t, s),
-        ..h
-    })
-}
-
-/// True when one ray from the eye hits some cached triangle packed in lanes.
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn any_soa<L: Lane>(ray: &Ray, cache: &[FocalTriangle<L>], cull: Cull) -> bool {
-    let (r, _) = scaled_ray(ray);
-    hit::any_soa(&r, cache, |r, e| maybe_hit(r, e, cull))
 }
 
 #[cfg(test)]

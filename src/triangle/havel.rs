@@ -2,7 +2,7 @@
 
 use super::precomputed::{PrecomputedKernel, precomputed_triangle_kernel};
 use super::{Cull, TrianglePacket, resolve};
-use crate::hit::LaneHit;
+use crate::kernel::LaneHit;
 use crate::lane::{Lane, Mask};
 use crate::ray::RayPacket;
 use crate::vec3::V3;

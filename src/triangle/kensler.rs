@@ -1,7 +1,7 @@
 //! Kensler and Shirley's optimised 3-D test (2006).
 
 use super::{Cull, TriangleKernel, TrianglePacket};
-use crate::hit::LaneHit;
+use crate::kernel::LaneHit;
 use crate::lane::{Lane, Mask};
 use crate::ray::RayPacket;
 

@@ -88,35 +88,17 @@ pub use havel::{HavelHerout, PlanesRecord};
 pub use kensler::KenslerShirley;
 pub use moller::Moller;
 pub use plucker::Plucker;
-pub use precomputed::{PrecomputedKernel, closest_precomputed, precompute_all};
+pub use precomputed::{PrecomputedKernel, precompute_all};
 pub use wald::{Wald, WaldRecord};
 pub use watertight::{Shear, Watertight};
 
 use glam::Vec3;
 
-use crate::hit::{self, Best, HitRecord, LaneHit};
+use crate::kernel::Cull;
+use crate::kernel::{Kernel, LaneHit, Primitive};
 use crate::lane::{Lane, Mask};
-use crate::ray::{Ray, RayPacket};
+use crate::ray::RayPacket;
 use crate::vec3::V3;
-
-/// Which faces a triangle test reports.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
-pub enum Cull {
-    /// Two-sided (the default): hits from either side.
-    #[default]
-    None,
-    /// Back-face culling: only front faces, `d·N < 0` with `N = (B − A) × (C − A)`.
-    Back,
-}
-
-impl Cull {
-    /// True for [`Cull::Back`].
-    #[inline(always)]
-    #[must_use]
-    pub fn back(self) -> bool {
-        matches!(self, Cull::Back)
-    }
-}
 
 /// A triangle: three vertices.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -377,88 +359,31 @@ pub(crate) fn within<L: Lane>(
     LaneHit::deferred(t, num_u, num_v, w, mask)
 }
 
-/// The hit of one ray on one triangle with kernel `K`, or `None`.
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn intersect<K: TriangleKernel>(ray: &Ray, tri: &Triangle, cull: Cull) -> Option<HitRecord> {
-    let r = RayPacket::<f32>::splat(ray);
-    K::intersect(&r, &K::prepare(&r), &TrianglePacket::splat(tri), cull)
-        .normalized()
-        .record()
-}
-
-/// Closest hit of ray lanes over a slice of triangles with kernel `K` (N rays × 1 triangle).
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn closest<K: TriangleKernel, L: Lane>(
-    rays: &RayPacket<L>,
-    tris: &[Triangle],
-    cull: Cull,
-) -> Best<L> {
-    let pre = K::prepare(rays);
-    hit::closest(rays, tris, |r, t| {
-        Some(K::intersect(r, &pre, &TrianglePacket::splat(t), cull))
-    })
-}
-
-/// Lanes whose ray hits some triangle (occlusion), with kernel `K`.
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn any<K: TriangleKernel, L: Lane>(
-    rays: &RayPacket<L>,
-    tris: &[Triangle],
-    cull: Cull,
-) -> L::Mask {
-    let pre = K::prepare(rays);
-    hit::any(rays, tris, |r, t| {
-        Some(K::intersect(r, &pre, &TrianglePacket::splat(t), cull))
-    })
-}
-
-/// Every hit: calls `f(index, hit)` for each triangle that some lane hits.
-#[inline]
-#[doc(hidden)]
-pub fn all<K: TriangleKernel, L: Lane>(
-    rays: &RayPacket<L>,
-    tris: &[Triangle],
-    cull: Cull,
-    mut f: impl FnMut(u32, &LaneHit<L>),
-) {
-    let pre = K::prepare(rays);
-    for (i, t) in tris.iter().enumerate() {
-        let h = K::intersect(rays, &pre, &TrianglePacket::splat(t), cull);
-        if h.mask.any() {
-            f(i as u32, &h.normalized());
-        }
+impl Primitive for Triangle {
+    type Packet<L: Lane> = TrianglePacket<L>;
+    #[inline(always)]
+    fn splat<L: Lane>(&self) -> TrianglePacket<L> {
+        TrianglePacket::splat(self)
     }
 }
 
-/// Closest hit of one ray over triangles packed in lanes (1 ray × N triangles); the index is
-/// the triangle's position in the slice that was packed.
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn closest_soa<K: TriangleKernel, L: Lane>(
-    ray: &Ray,
-    tris: &[TrianglePacket<L>],
-    cull: Cull,
-) -> Option<HitRecord> {
-    let pre = K::prepare(&RayPacket::<L>::splat(ray));
-    hit::closest_soa(ray, tris, |r, t| Some(K::intersect(r, &pre, t, cull)))
-}
+/// Every triangle kernel is a [`Kernel`] of triangles (its one hit per triangle; `u`, `v` may
+/// be deferred).
+impl<K: TriangleKernel> Kernel<Triangle> for K {
+    type Rays<L: Lane> = K::Rays<L>;
 
-/// True when one ray hits some triangle packed in lanes.
-#[inline]
-#[must_use]
-#[doc(hidden)]
-pub fn any_soa<K: TriangleKernel, L: Lane>(
-    ray: &Ray,
-    tris: &[TrianglePacket<L>],
-    cull: Cull,
-) -> bool {
-    let pre = K::prepare(&RayPacket::<L>::splat(ray));
-    hit::any_soa(ray, tris, |r, t| Some(K::intersect(r, &pre, t, cull)))
+    #[inline(always)]
+    fn prepare<L: Lane>(rays: &RayPacket<L>) -> K::Rays<L> {
+        K::prepare(rays)
+    }
+
+    #[inline(always)]
+    fn first<L: Lane>(
+        rays: &RayPacket<L>,
+        pre: &K::Rays<L>,
+        tri: &TrianglePacket<L>,
+        cull: Cull,
+    ) -> LaneHit<L> {
+        K::intersect(rays, pre, tri, cull)
+    }
 }

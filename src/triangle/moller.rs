@@ -1,7 +1,7 @@
 //! Möller–Trumbore with the division deferred (as in Embree's `triangle_intersector_moeller`).
 
 use super::{Cull, TriangleKernel, TrianglePacket, resolve};
-use crate::hit::LaneHit;
+use crate::kernel::LaneHit;
 use crate::lane::{Lane, Mask};
 use crate::ray::RayPacket;
 

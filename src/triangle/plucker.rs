@@ -2,7 +2,7 @@
 //! Embree's `triangle_intersector_pluecker.h`).
 
 use super::{Cull, TriangleKernel, TrianglePacket, resolve};
-use crate::hit::LaneHit;
+use crate::kernel::LaneHit;
 use crate::lane::{Lane, Mask};
 use crate::ray::RayPacket;
 

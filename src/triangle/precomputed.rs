@@ -1,8 +1,7 @@
 //! Triangle tests that run on data computed once per triangle.
 
 use super::{Cull, Triangle, TrianglePacket};
-use crate::hit::Best;
-use crate::hit::LaneHit;
+use crate::kernel::LaneHit;
 use crate::lane::Lane;
 use crate::ray::RayPacket;
 
@@ -15,12 +14,12 @@ use crate::ray::RayPacket;
 /// [`Counted`](crate::opcount::Counted) it measures the precomputation's own operation count.
 /// Every implementor is also a [`TriangleKernel`](super::TriangleKernel) that precomputes on the fly, so the entry
 /// points, the checker and the tests run it unchanged; store records with [`precompute_all`]
-/// and query them with [`closest_precomputed`] to pay the precomputation once.
+/// and test them with [`test`](Self::test) to pay the precomputation once.
 ///
 /// ```
 /// use glam::Vec3;
-/// use raylane::triangle::{Cull, PrecomputedKernel, Triangle, TrianglePacket, Wald};
-/// use raylane::RayPacket;
+/// use raylane::triangle::{PrecomputedKernel, Triangle, TrianglePacket, Wald};
+/// use raylane::{Cull, RayPacket};
 ///
 /// let tri = Triangle::new(Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0));
 /// let rec = Wald::precompute(&TrianglePacket::<f32>::splat(&tri)); // once per triangle
@@ -58,7 +57,7 @@ macro_rules! precomputed_triangle_kernel {
                 _: &(),
                 tri: &$crate::triangle::TrianglePacket<L>,
                 cull: $crate::triangle::Cull,
-            ) -> $crate::hit::LaneHit<L> {
+            ) -> $crate::kernel::LaneHit<L> {
                 use $crate::triangle::PrecomputedKernel as _;
                 <$k>::test(ray, &<$k>::precompute(tri), cull)
             }
@@ -87,7 +86,7 @@ pub(crate) fn cyclic<L: Lane>(k: (L::Mask, L::Mask), v: crate::vec3::V3<L>) -> c
 
 /// Records of `tris` into `out`, one per triangle, each in every lane (from
 /// [`TrianglePacket::splat`]); returns the number written (at most `out.len()`). Build them
-/// once; [`closest_precomputed`] reads them.
+/// once; [`PrecomputedKernel::test`] reads them.
 pub fn precompute_all<K: PrecomputedKernel, L: Lane>(
     tris: &[Triangle],
     out: &mut [K::Prim<L>],
@@ -98,17 +97,4 @@ pub fn precompute_all<K: PrecomputedKernel, L: Lane>(
         n += 1;
     }
     n
-}
-
-/// Closest hit of ray lanes over stored records (N rays × 1 triangle, records from
-/// [`precompute_all`]): the same hits, bit for bit, as [`closest`](super::closest) with `K`,
-/// without precomputing per query. The index is the record's position.
-#[inline]
-#[must_use]
-pub fn closest_precomputed<K: PrecomputedKernel, L: Lane>(
-    rays: &RayPacket<L>,
-    records: &[K::Prim<L>],
-    cull: Cull,
-) -> Best<L> {
-    crate::hit::closest(rays, records, |r, p| Some(K::test(r, p, cull)))
 }

@@ -1,7 +1,7 @@
 //! The watertight test of Woop, Benthin and Wald (JCGT 2(1), 2013).
 
 use super::{Cull, TriangleKernel, TrianglePacket, resolve};
-use crate::hit::LaneHit;
+use crate::kernel::LaneHit;
 use crate::lane::{Lane, Mask, Scalar};
 use crate::ray::RayPacket;
 use crate::vec3::V3;
@@ -138,24 +138,6 @@ impl TriangleKernel for Watertight {
         let a = sh.permute(tri.a) - sh.origin;
         let b = sh.permute(tri.b) - sh.origin;
         let c = sh.permute(tri.c) - sh.origin;
-        sheared(ray, sh, a, b, c, cull)
-    }
-}
-
-impl Watertight {
-    /// [`intersect`](TriangleKernel::intersect) with the vertices already relative to the
-    /// rays' origin (`A − o`, `B − o`, `C − o`, each rounded once, as step 1 computes them):
-    /// the same bits, 9 subtractions fewer. The BVH's per-eye cache uses it.
-    #[inline(always)]
-    pub(crate) fn intersect_relative<L: Lane>(
-        ray: &RayPacket<L>,
-        sh: &Shear<L>,
-        rel: &TrianglePacket<L>,
-        cull: Cull,
-    ) -> LaneHit<L> {
-        // Permuting `A − o` gives the bits of `permute(A) − permute(o)`: both subtract the
-        // same two coordinates per lane.
-        let (a, b, c) = (sh.permute(rel.a), sh.permute(rel.b), sh.permute(rel.c));
         sheared(ray, sh, a, b, c, cull)
     }
 }

@@ -12,16 +12,16 @@
 use core::ptr::{addr_of, addr_of_mut, read_volatile, write_volatile};
 
 use glam::Vec3;
-use raylane::internals;
-use raylane::internals::Best;
 use raylane::mesh::Mesh;
 use raylane::plane::{FocalPlane, Plane};
 use raylane::sphere::focal::{Focal, FocalKernel};
 use raylane::sphere::{FocalSphere, Robust, Sphere, SphereKernel, SpherePacket};
 use raylane::triangle::{
-    self, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket, Watertight,
+    FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket, Watertight,
 };
-use raylane::{Lane, Mask, Query, Ray, RayPacket};
+use raylane::{Cull, Lane, Mask, Query, Ray, RayPacket};
+use raylane_lab::loops as internals;
+use raylane_lab::loops::Best;
 use raylane_lab::registry::{Kernel, Visitor};
 use raylane_lab::vectors::{Case, Kind, Values};
 
@@ -155,7 +155,7 @@ fn query_hits<L: Lane<Scalar = f32>>(h: &raylane::Hits<L>) {
     sink(h.mask.bits() ^ h.t.lane(0).to_bits() ^ h.normal.x.lane(0).to_bits());
 }
 
-fn rec(r: Option<raylane::internals::HitRecord>) {
+fn rec(r: Option<raylane_lab::loops::HitRecord>) {
     sink(r.map_or(7, |h| h.t.to_bits() ^ h.index));
 }
 
@@ -203,8 +203,12 @@ impl<L: Lane<Scalar = f32>> Visitor for Closest<'_, L> {
     }
     fn focal_triangle(self, _: Kernel) {
         let mut cache = [FocalTriangle::never(); 2];
-        triangle::focal::focus(self.eye, self.tris, &mut cache);
-        hits(&triangle::focal::closest(self.rays, &cache, Cull::None));
+        internals::triangle::focal::focus(self.eye, self.tris, &mut cache);
+        hits(&internals::triangle::focal::closest(
+            self.rays,
+            &cache,
+            Cull::None,
+        ));
     }
 }
 
@@ -260,15 +264,15 @@ pub fn every_kernel<L: Lane<Scalar = f32>>(rays: &RayPacket<L>, ray: &Ray) {
         Cull::None,
     ));
     let mut tcache = [FocalTriangle::never(); 2];
-    triangle::focal::focus(eye, &tris, &mut tcache);
-    sink(triangle::focal::any(rays, &tcache, Cull::None).bits());
+    internals::triangle::focal::focus(eye, &tris, &mut tcache);
+    sink(internals::triangle::focal::any(rays, &tcache, Cull::None).bits());
     let positions = [v(0), v(3), v(6), v(9)];
     let indices = [[0u32, 1, 2], [1, 3, 2], [0, 3, 9]];
     let mesh = Mesh::bounded(&positions, &indices);
     query_hits(&mesh.closest(rays));
     sink(mesh.using::<Moller>().any(rays).bits());
     let mut mcache = [FocalTriangle::never(); 3];
-    if let Ok(fm) = mesh.focus(eye, &mut mcache) {
+    if let Ok(fm) = raylane::focal::FocalMesh::new(&mesh, eye, &mut mcache) {
         query_hits(&fm.closest(rays));
     }
 }

@@ -2,7 +2,6 @@
 //! point. (Triangles have their own bad-input tests in tests/triangles.rs.)
 
 use glam::Vec3;
-use raylane::internals;
 use raylane::plane::{FocalPlane, Plane};
 use raylane::sphere::focal::Focal;
 use raylane::sphere::focal::FocalKernel;
@@ -11,6 +10,7 @@ use raylane::sphere::{
 };
 use raylane::triangle::TriangleKernel;
 use raylane::{Lane, Ray, RayPacket};
+use raylane_lab::loops as internals;
 use raylane_lab::registry::{Kernel, Prim, Visitor};
 use wide::f32x8;
 

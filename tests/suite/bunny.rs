@@ -24,12 +24,14 @@
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
-use raylane::internals;
-use raylane::internals::HitRecord;
+use raylane::Cull;
 use raylane::mesh::Mesh;
 use raylane::triangle::Triangle;
-use raylane::triangle::{Cull, FocalTriangle, Moller, TriangleKernel, Watertight};
+use raylane::triangle::{FocalTriangle, Moller, TriangleKernel, Watertight};
 use raylane::{Lane, Ray, RayPacket};
+use raylane_lab::loops as internals;
+use raylane_lab::loops::HitRecord;
+use raylane_lab::loops::LaneRecords;
 use wide::{f32x4, f32x8, f32x16};
 
 use crate::exact_ref::exact;
@@ -292,7 +294,7 @@ fn closest_among<K: TriangleKernel>(m: &Model, cand: &[u32], ray: &Ray) -> Optio
 }
 
 fn focal_packets<L: Lane<Scalar = f32>>(
-    fm: &raylane::mesh::FocalMesh,
+    fm: &raylane::focal::FocalMesh,
     rays: &[Ray],
 ) -> Vec<Option<HitRecord>> {
     rays.chunks(L::LANES)
@@ -419,7 +421,7 @@ fn one_eye(
                 Ray::new(eye, target - eye)
             })
             .collect();
-        let fm = mesh.focus(eye, cache).unwrap();
+        let fm = raylane::focal::FocalMesh::new(mesh, eye, cache).unwrap();
         let f = focal_packets::<f32x8>(&fm, &rays);
         if all_shapes {
             let others = [
@@ -491,7 +493,7 @@ fn bunny_69k_visible_surface() {
     );
     let mesh = Mesh::new(&m.pos, &m.idx);
     let mut cache = vec![FocalTriangle::never(); m.idx.len()];
-    let fm = mesh.focus(eye, &mut cache).unwrap();
+    let fm = raylane::focal::FocalMesh::new(&mesh, eye, &mut cache).unwrap();
     let ray = Ray::new(eye, dir);
     let h = record(fm.closest(&RayPacket::<f32x8>::splat(&ray)).lane(0));
     let w = record(mesh.closest(&ray));

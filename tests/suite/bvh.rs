@@ -12,21 +12,24 @@ use crate::query::bits;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
+use raylane::Cull;
 use raylane::bvh::{self, BuildError, Bvh, Node, Packed, Primitives, Scratch, Sphere4, Tri4};
 use raylane::mesh::Mesh;
+use raylane::set::TooSmall;
 use raylane::sphere::{Robust, Sphere};
-use raylane::triangle::{Cull, Triangle, Watertight};
+use raylane::triangle::{Moller, Triangle, Watertight};
 use raylane::{Hit, Lane, Mask, Query, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
 /// A tree over `p` in owned vectors trimmed to what the build used.
 pub(crate) fn owned<P: Primitives + ?Sized>(p: &P) -> (Vec<Node>, Vec<P::Leaf>) {
-    let need = bvh::needed(p.count());
+    let need = bvh::TriangleBvh::needed(p.count());
     let mut nodes = vec![Node::EMPTY; need.nodes];
     let mut leaves = vec![P::Leaf::EMPTY; need.leaves];
     let mut scratch = vec![Scratch::default(); need.scratch];
     let (n, l) = {
-        let b = bvh::build(p, &mut nodes, &mut leaves, &mut scratch).expect("storage from needed");
+        let b =
+            bvh::Bvh::build(p, &mut nodes, &mut leaves, &mut scratch).expect("storage from needed");
         (b.nodes().len(), b.leaves().len())
     };
     nodes.truncate(n);
@@ -98,33 +101,16 @@ pub(crate) fn check(tree: &impl Query, flat: &impl Query, rays: &[Ray]) -> usize
     hits
 }
 
-/// Checks a triangle set against brute force on `rays`; returns the hit count.
-/// Also in focal mode (both node caches): the tree focused on each of the first 300 rays'
-/// origins answers that ray as brute force does.
+/// Checks a triangle set against brute force on `rays`; returns the hit count. Also with
+/// another kernel ([`Moller`]), which the tree takes as the flat set does.
 fn check_tris(tris: &[Triangle], rays: &[Ray]) -> usize {
     let (nodes, leaves) = owned(tris);
     let tree = Bvh::from_parts(&nodes, &leaves).expect("a valid tree");
-    let mut fnodes = vec![bvh::FocalNode::EMPTY; nodes.len()];
-    let mut fleaves = vec![bvh::FocalLeaf::EMPTY; leaves.len()];
-    let mut snodes = vec![<bvh::SphereNode as bvh::NodeCache>::EMPTY; nodes.len()];
-    for r in rays.iter().take(300) {
-        let focal = tree.focus(r.origin(), &mut fnodes, &mut fleaves).unwrap();
-        assert_eq!(
-            bits(focal.closest(r)),
-            bits(tris.closest(r)),
-            "focal: {r:?}"
-        );
-        assert_eq!(focal.any(r), tris.any(r), "focal any: {r:?}");
-        let spheres = tree
-            .focus_with(r.origin(), &mut snodes, &mut fleaves)
-            .unwrap();
-        assert_eq!(
-            bits(spheres.closest(r)),
-            bits(tris.closest(r)),
-            "spheres: {r:?}"
-        );
-        assert_eq!(spheres.any(r), tris.any(r), "spheres any: {r:?}");
-    }
+    check(
+        &tree.using::<Moller>(),
+        &tris.using::<Moller>(),
+        &rays[..rays.len().min(300)],
+    );
     check(&tree, &tris, rays)
 }
 
@@ -166,11 +152,9 @@ fn random_triangle_soups_equal_brute_force() {
         assert!(hits > 100, "{n} triangles: only {hits} hits");
         // Front faces only.
         let (nodes, leaves) = owned(&tris[..]);
-        let tree = Bvh::from_parts(&nodes, &leaves)
-            .unwrap()
-            .with_cull(Cull::Back);
+        let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
         let culled = tris[..].using::<Watertight>().culled(Cull::Back);
-        assert!(check(&tree, &culled, &rs[..200]) > 20);
+        assert!(check(&tree.culled(Cull::Back), &culled, &rs[..200]) > 20);
     }
 }
 
@@ -186,11 +170,9 @@ fn random_sphere_sets_equal_brute_force() {
         let hits = check_spheres(&spheres, &rs);
         assert!(hits > 100, "{n} spheres: only {hits} hits");
         let (nodes, leaves) = owned(&spheres[..]);
-        let tree = Bvh::from_parts(&nodes, &leaves)
-            .unwrap()
-            .with_cull(Cull::Back);
+        let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
         let culled = spheres[..].using::<Robust>().culled(Cull::Back);
-        assert!(check(&tree, &culled, &rs[..200]) > 20);
+        assert!(check(&tree.culled(Cull::Back), &culled, &rs[..200]) > 20);
     }
 }
 
@@ -389,30 +371,34 @@ fn bad_input_builds_valid_trees() {
 fn short_storage_is_an_error() {
     let mut rng = SmallRng::seed_from_u64(19);
     let tris = soup(&mut rng, 100);
-    let need = bvh::needed(tris.len());
+    let need = bvh::TriangleBvh::needed(tris.len());
     let mut nodes = vec![Node::EMPTY; need.nodes];
     let mut leaves = vec![Tri4::EMPTY; need.leaves];
     let mut scratch = vec![Scratch::default(); need.scratch];
     assert_eq!(
-        bvh::build(
+        bvh::Bvh::build(
             &tris[..],
             &mut nodes[..need.nodes - 1],
             &mut leaves,
             &mut scratch
         )
         .err(),
-        Some(BuildError::Nodes(need.nodes))
+        Some(BuildError::Nodes(TooSmall { needed: need.nodes }))
     );
     assert_eq!(
-        bvh::build(&tris[..], &mut nodes, &mut leaves[..3], &mut scratch).err(),
-        Some(BuildError::Leaves(need.leaves))
+        bvh::Bvh::build(&tris[..], &mut nodes, &mut leaves[..3], &mut scratch).err(),
+        Some(BuildError::Leaves(TooSmall {
+            needed: need.leaves
+        }))
     );
     assert_eq!(
-        bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch[..0]).err(),
-        Some(BuildError::Scratch(need.scratch))
+        bvh::Bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch[..0]).err(),
+        Some(BuildError::Scratch(TooSmall {
+            needed: need.scratch
+        }))
     );
-    assert!(bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch).is_ok());
-    assert_eq!(bvh::needed(0).nodes, 1);
+    assert!(bvh::Bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch).is_ok());
+    assert_eq!(bvh::TriangleBvh::needed(0).nodes, 1);
 }
 
 /// Same input, same bytes (the builder uses no hashing, no addresses, no fused operations).
@@ -455,12 +441,12 @@ fn builds_are_deterministic() {
 fn refit_after_moving_vertices() {
     let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
     let mut pos = m.pos.clone();
-    let need = bvh::needed(m.idx.len());
+    let need = bvh::TriangleBvh::needed(m.idx.len());
     let mut nodes = vec![Node::EMPTY; need.nodes];
     let mut leaves = vec![Tri4::EMPTY; need.leaves];
     let mut scratch = vec![Scratch::default(); need.scratch];
     let (n, l) = {
-        let b = bvh::build(
+        let b = bvh::Bvh::build(
             &Mesh::new(&pos, &m.idx),
             &mut nodes,
             &mut leaves,
@@ -474,7 +460,7 @@ fn refit_after_moving_vertices() {
         *p += Vec3::new((p.y * 40.0).sin() * 0.01, 0.0, (p.x * 30.0).cos() * 0.02);
     }
     let mesh = Mesh::new(&pos, &m.idx);
-    let tree = bvh::refit(&mesh, &mut nodes[..n], &mut leaves[..l]).unwrap();
+    let tree = bvh::Bvh::refit(&mesh, &mut nodes[..n], &mut leaves[..l]).unwrap();
     let mut rng = SmallRng::seed_from_u64(21);
     let aim: Vec<Vec3> = (0..200).map(|i| pos[i * 7]).collect();
     let rs: Vec<Ray> = (0..1500)
@@ -601,7 +587,7 @@ fn instanced_scenes_equal_instance_by_instance() {
     instances.push(Instance::new(1, flat_t));
     instances.push(Instance::new(7, transform(&mut rng, 1.0, false)));
     assert!(!instances[24].invertible && instances[0].invertible && instances[5].mirror);
-    let need = bvh::needed(instances.len());
+    let need = bvh::TriangleBvh::needed(instances.len());
     let mut nodes = vec![Node::EMPTY; need.nodes];
     let mut leaves = vec![Inst4::EMPTY; need.leaves];
     let mut scratch = vec![Scratch::default(); need.scratch];

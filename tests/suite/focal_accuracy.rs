@@ -15,9 +15,10 @@
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
+use raylane::Cull;
 use raylane::Ray;
-use raylane::internals;
-use raylane::triangle::{Cull, FocalTriangle, Moller, Triangle, Watertight};
+use raylane::triangle::{FocalTriangle, Moller, Triangle, Watertight};
+use raylane_lab::loops as internals;
 
 use crate::exact_ref::{Exact, exact};
 
@@ -155,7 +156,7 @@ struct Stat {
 }
 
 impl Stat {
-    fn add(&mut self, x: &Exact, h: Option<raylane::internals::HitRecord>) {
+    fn add(&mut self, x: &Exact, h: Option<raylane_lab::loops::HitRecord>) {
         match h {
             Some(h) => {
                 self.t = self.t.max(x.t_err(h.t));

@@ -3,14 +3,14 @@
 //! records (issue 10: the interval bug, Required 5 and 6).
 
 use glam::Vec3;
-use raylane::internals;
-use raylane::internals::HitRecord;
+use raylane::Cull;
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
-use raylane::triangle::{
-    Cramer, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, Watertight,
-};
+use raylane::triangle::{Cramer, FocalTriangle, Moller, Triangle, TriangleKernel, Watertight};
 use raylane::{Query, Ray, RayPacket};
+use raylane_lab::loops as internals;
+use raylane_lab::loops::HitRecord;
+use raylane_lab::loops::LaneRecords;
 use wide::{f32x4, f32x8, f32x16};
 
 /// Every focal entry point on one ray over `tris` from the ray's origin: the scalar record
@@ -85,7 +85,9 @@ fn focal_all_entry_points(ray: &Ray, tris: &[Triangle], cull: Cull) -> Option<Hi
         Mesh::bounded(&positions, &indices),
     ] {
         let mut out = vec![FocalTriangle::never(); tris.len()];
-        let fm = mesh.focus(eye, &mut out).unwrap().culled(cull);
+        let fm = raylane::focal::FocalMesh::new(&mesh, eye, &mut out)
+            .unwrap()
+            .culled(cull);
         let fr = RayPacket::<f32x8>::splat(ray);
         let h = fm.closest(&fr);
         for i in 0..8 {

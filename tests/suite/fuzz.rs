@@ -25,9 +25,8 @@ use crate::query::record;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
+use raylane::Cull;
 use raylane::bounds::{self, Bound};
-use raylane::internals;
-use raylane::internals::{Best, HitRecord};
 use raylane::mesh::Mesh;
 use raylane::plane::{FocalPlane, Plane, PlanePacket};
 use raylane::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
@@ -36,9 +35,11 @@ use raylane::sphere::{
     SpherePacket,
 };
 use raylane::triangle::{
-    Cramer, Cull, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket, Watertight,
+    Cramer, FocalTriangle, Moller, Triangle, TriangleKernel, TrianglePacket, Watertight,
 };
 use raylane::{Hits, Lane, Mask, Pinhole, Query, Ray, RayPacket};
+use raylane_lab::loops as internals;
+use raylane_lab::loops::{Best, HitRecord, LaneRecords};
 use wide::{f32x4, f32x8, f32x16};
 
 /// Focal triangle hits are checked to be finite and strictly inside their interval (issue 10,
@@ -709,11 +710,15 @@ fn focal_meshes<L: Lane<Scalar = f32>>(c: &Case, cull: Cull) {
     let packet = RayPacket::<L>::from_rays(rays);
     let plain = Mesh::new(&c.positions, &c.indices);
     let invalid = plain.with_bound(&Sphere::new(Vec3::ZERO, -1.0));
-    let mut base = vec![FocalTriangle::never(); plain.needed()];
-    let unbounded = plain.focus(c.eye, &mut base).unwrap().culled(cull);
+    let mut base = vec![FocalTriangle::never(); raylane::focal::FocalMesh::needed(&plain)];
+    let unbounded = raylane::focal::FocalMesh::new(&plain, c.eye, &mut base)
+        .unwrap()
+        .culled(cull);
     for m in [plain, Mesh::bounded(&c.positions, &c.indices), invalid] {
-        let mut cache = vec![FocalTriangle::never(); m.needed()];
-        let fm = m.focus(c.eye, &mut cache).unwrap().culled(cull);
+        let mut cache = vec![FocalTriangle::never(); raylane::focal::FocalMesh::needed(&m)];
+        let fm = raylane::focal::FocalMesh::new(&m, c.eye, &mut cache)
+            .unwrap()
+            .culled(cull);
         let h = Query::closest(&fm, &packet);
         let any = Query::any(&fm, &packet);
         let one = |ray: &Ray| record(Query::closest(&fm, ray));

@@ -4,14 +4,14 @@
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
-use raylane::internals;
-use raylane::internals::Best;
 use raylane::lane::{Lane, Mask};
 use raylane::plane::{FocalPlane, Plane, PlanePacket};
 use raylane::sphere::focal::{Focal, FocalKernel};
 use raylane::sphere::{FocalSphere, Robust, Roots, Sphere, SphereKernel, SpherePacket};
 use raylane::triangle::TriangleKernel;
 use raylane::{Ray, RayPacket, V3};
+use raylane_lab::loops as internals;
+use raylane_lab::loops::{Best, LaneRecords};
 use raylane_lab::registry::{Kernel, Prim, Visitor};
 use std::marker::PhantomData;
 use wide::{f32x4, f32x8, f32x16};

@@ -5,7 +5,6 @@ mod accuracy;
 mod bad_input;
 mod bunny;
 mod bvh;
-mod bvh_focal;
 mod doc_counts;
 mod exact_ref;
 mod focal_accuracy;

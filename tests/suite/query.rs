@@ -9,12 +9,14 @@
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
-use raylane::internals;
+use raylane::Cull;
 use raylane::lane::{Lane, Mask};
 use raylane::plane::Plane;
 use raylane::sphere::{Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
-use raylane::triangle::{Cull, Moller, Triangle, Watertight};
+use raylane::triangle::{Moller, Triangle, Watertight};
 use raylane::{Hit, Hits, Query, Ray, RayPacket};
+use raylane_lab::loops as internals;
+use raylane_lab::loops::LaneRecords;
 use wide::{f32x4, f32x8, f32x16};
 
 use crate::bunny::load_bin;
@@ -50,8 +52,8 @@ fn ray(rng: &mut SmallRng, c: Vec3, scale: f32) -> Ray {
 
 /// A query's record as the kernels' record (`t`, `u`, `v`, index), for the tests that compare
 /// with the kernels' own entry points.
-pub fn record(h: Option<Hit>) -> Option<raylane::internals::HitRecord> {
-    h.map(|h| raylane::internals::HitRecord {
+pub fn record(h: Option<Hit>) -> Option<raylane_lab::loops::HitRecord> {
+    h.map(|h| raylane_lab::loops::HitRecord {
         t: h.t,
         u: h.u,
         v: h.v,
@@ -284,7 +286,7 @@ fn plane_and_scene_queries_every_lane_equals_one_ray() {
 #[test]
 fn mesh_and_focal_mesh_queries_every_lane_equals_one_ray() {
     use raylane::mesh::Mesh;
-    use raylane::query::TooSmall;
+    use raylane::set::TooSmall;
     use raylane::triangle::FocalTriangle;
     let m = load_bin(include_bytes!("../data/bunny.bin"));
     // Two invalid triangles (an index out of range, a zero-area one): listed once, never hit.
@@ -322,14 +324,14 @@ fn mesh_and_focal_mesh_queries_every_lane_equals_one_ray() {
             "{what} vs the same triangles"
         );
     }
-    // Focal: rays from the eye; rays from elsewhere are a miss.
+    // Focal: rays from the eye; rays from elsewhere get the mesh's own answer, bit for bit.
     let eye = c + Vec3::new(0.2, 0.3, 2.0) * size;
-    let mut cache = vec![FocalTriangle::never(); mesh.needed()];
+    let mut cache = vec![FocalTriangle::never(); raylane::focal::FocalMesh::needed(&mesh)];
     assert_eq!(
-        mesh.focus(eye, &mut cache[..10]).err(),
+        raylane::focal::FocalMesh::new(&mesh, eye, &mut cache[..10]).err(),
         Some(TooSmall { needed: idx.len() })
     );
-    let fm = bounded.focus(eye, &mut cache).unwrap();
+    let fm = raylane::focal::FocalMesh::new(&bounded, eye, &mut cache).unwrap();
     let from_eye: Vec<Ray> = (0..160)
         .map(|_| Ray::new(eye, (c + vec(&mut rng, 0.6 * size) - eye).normalize()))
         .collect();
@@ -340,20 +342,24 @@ fn mesh_and_focal_mesh_queries_every_lane_equals_one_ray() {
         let w = tris.closest(r);
         assert_eq!(h.map(|h| h.index), w.map(|w| w.index), "{r:?}");
         let elsewhere = Ray::new(r.origin() + Vec3::X * 1e-3, r.dir());
-        assert_eq!(Query::closest(&fm, &elsewhere), None);
-        assert!(!Query::any(&fm, &elsewhere));
+        assert_eq!(
+            bits(Query::closest(&fm, &elsewhere)),
+            bits(bounded.closest(&elsewhere))
+        );
+        assert_eq!(Query::any(&fm, &elsewhere), bounded.any(&elsewhere));
     }
     let culled = every_width(&fm.culled(Cull::Back), &from_eye, "culled focal mesh");
     assert!(culled.iter().flatten().all(|h| h.front));
 }
 
 #[test]
-fn focal_spheres_and_planes_own_their_eye() {
+fn focal_spheres_and_planes_answer_every_ray() {
     use raylane::Dir;
-    use raylane::plane::{FocalPlane, FocalPlanes};
-    use raylane::query::TooSmall;
+    use raylane::focal::FocalPlanes;
+    use raylane::focal::FocalSpheres;
+    use raylane::plane::FocalPlane;
+    use raylane::set::TooSmall;
     use raylane::sphere::FocalSphere;
-    use raylane::sphere::focal::FocalSpheres;
     let mut rng = SmallRng::seed_from_u64(15);
     let s = spheres(&mut rng, 20);
     let planes: Vec<Plane> = (0..4)
@@ -362,12 +368,12 @@ fn focal_spheres_and_planes_own_their_eye() {
     let eye = Vec3::new(1.0, 2.0, 12.0);
     let mut sc = vec![FocalSphere::pass_all(); FocalSpheres::needed(&s)];
     assert_eq!(
-        FocalSpheres::focus(eye, &s, &mut sc[..3]).err(),
+        FocalSpheres::new(&s, eye, &mut sc[..3]).err(),
         Some(TooSmall { needed: 20 })
     );
-    let fs = FocalSpheres::focus(eye, &s, &mut sc).unwrap();
+    let fs = FocalSpheres::new(&s, eye, &mut sc).unwrap();
     let mut pc = vec![FocalPlane::new(eye, &planes[0]); FocalPlanes::needed(&planes)];
-    let fp = FocalPlanes::focus(eye, &planes, &mut pc).unwrap();
+    let fp = FocalPlanes::new(&planes, eye, &mut pc).unwrap();
     let rays: Vec<Ray> = (0..160)
         .map(|_| match Dir::new(vec(&mut rng, 8.0) - eye) {
             Some(d) => Ray::unit(eye, d),
@@ -387,11 +393,17 @@ fn focal_spheres_and_planes_own_their_eye() {
         if let (Some(h), Some(w)) = (h, w) {
             assert!((h.t - w.t).abs() <= w.t * 1.0 / 65536.0);
         }
-        // Not from the eye, or not unit length: a miss.
+        // Not from the eye, or not unit length: the spheres' own answer (Robust), bit for bit.
         let moved = Ray::new(r.origin() + Vec3::Y, r.dir());
         let long = Ray::new(r.origin(), r.dir() * 1.5);
-        assert_eq!((fs.closest(&moved), fs.closest(&long)), (None, None));
-        assert!(!fs.any(&moved) && !fs.any(&long));
+        for other in [moved, long] {
+            assert_eq!(
+                bits(fs.closest(&other)),
+                bits(s.closest(&other)),
+                "{other:?}"
+            );
+            assert_eq!(fs.any(&other), s.any(&other));
+        }
     }
     every_width(&fs.culled(Cull::Back), &rays, "culled focal spheres");
     let ph = every_width(&fp, &rays, "focal planes");
@@ -401,7 +413,8 @@ fn focal_spheres_and_planes_own_their_eye() {
             bits(planes.closest(r)),
             "focal planes vs planes: {r:?}"
         );
-        assert_eq!(fp.closest(&Ray::new(r.origin() + Vec3::X, r.dir())), None);
+        let moved = Ray::new(r.origin() + Vec3::X, r.dir());
+        assert_eq!(bits(fp.closest(&moved)), bits(planes.closest(&moved)));
     }
     assert_eq!(Dir::new(Vec3::ZERO), None);
     assert_eq!(

@@ -13,9 +13,10 @@
 //! Run with `--nocapture` to see the counts and digests.
 
 use glam::Vec3;
+use raylane::Cull;
 use raylane::plane::FocalPlane;
 use raylane::sphere::FocalSphere;
-use raylane::triangle::{Cull, FocalTriangle};
+use raylane::triangle::FocalTriangle;
 use raylane::{Lane, RayPacket, V3};
 use raylane_lab::demo::{
     self, Camera, Frame, ID_NONE, ID_SPHERE, ID_TRIANGLE, Part, Scene, Storage,
@@ -435,11 +436,12 @@ fn bunny_fw_render_is_pinned_at_every_width() {
     assert_eq!(bunny::load(bin, &mut tris), Some(bunny::TRIANGLES));
     assert_eq!(bunny::load(&bin[..bin.len() - 1], &mut tris), None);
     assert_eq!(bunny::load(bin, &mut tris[..10]), None);
-    let need = bvh::needed(tris.len());
+    let need = bvh::TriangleBvh::needed(tris.len());
     let mut nodes = vec![Node::EMPTY; need.nodes];
     let mut leaves = vec![<Tri4 as Packed>::EMPTY; need.leaves];
     let mut scratch = vec![Scratch::default(); need.scratch];
-    let tree = bvh::build(&tris[..], &mut nodes[..], &mut leaves[..], &mut scratch[..]).unwrap();
+    let tree =
+        bvh::Bvh::build(&tris[..], &mut nodes[..], &mut leaves[..], &mut scratch[..]).unwrap();
     let (w, h) = bunny::SIZE;
     let cam = bunny::camera(&tris, w, h);
     let image = |f: fn(&bvh::TriangleBvh, &raylane::Pinhole, &mut [u8]) -> Option<u32>| {

@@ -6,7 +6,6 @@ use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bounds::{self, Bound};
-use raylane::internals;
 use raylane::mesh::Mesh;
 use raylane::sphere::focal::{Focal, FocalKernel};
 use raylane::sphere::{
@@ -15,6 +14,8 @@ use raylane::sphere::{
 };
 use raylane::triangle::FocalTriangle;
 use raylane::{Lane, Pinhole, Ray, RayPacket, V3};
+use raylane_lab::loops as internals;
+use raylane_lab::loops::LaneRecords;
 
 /// `v` as an exact `f64` vector.
 fn w(v: Vec3) -> V3<f64> {
@@ -96,7 +97,7 @@ fn invalid_bound_culls_nothing_in_mesh_and_focal_mesh() {
         let h = raylane::Query::closest(&mesh, &ray);
         assert_eq!(h.map(|h| h.t), Some(5.0));
         let mut cache = [FocalTriangle::never(); 2];
-        let fm = mesh.focus(Vec3::ZERO, &mut cache).unwrap();
+        let fm = raylane::focal::FocalMesh::new(&mesh, Vec3::ZERO, &mut cache).unwrap();
         let fh = raylane::Query::closest(&fm, &RayPacket::<f32x8>::splat(&ray));
         for i in 0..8 {
             assert_eq!(fh.lane(i).map(|h| h.t), Some(5.0), "focal mesh, lane {i}");

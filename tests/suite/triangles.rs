@@ -8,21 +8,24 @@ use crate::query::record;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
+use raylane::Cull;
 use raylane::bounds::{self, Bound};
-use raylane::internals;
-use raylane::internals::Best;
-use raylane::internals::{FocalRays, HitRecord, LaneHit};
+use raylane::kernel::LaneHit;
 use raylane::lane::{Lane, Mask};
 use raylane::mesh::Mesh;
 use raylane::opcount::OpCounts;
 use raylane::sphere::SphereKernel;
 use raylane::sphere::focal::FocalKernel;
+use raylane::triangle::focal::FocalRays;
 use raylane::triangle::{
-    self, Badouel, BaldwinWeber, Cramer, Cull, FocalTriangle, HavelHerout, Moller, Plucker,
+    self, Badouel, BaldwinWeber, Cramer, FocalTriangle, HavelHerout, Moller, Plucker,
     PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight,
 };
 use raylane::{Hits, Query, Ray, RayPacket};
 use raylane_lab::demo::shapes;
+use raylane_lab::loops as internals;
+use raylane_lab::loops::HitRecord;
+use raylane_lab::loops::{Best, LaneRecords};
 use raylane_lab::opcount::table;
 use raylane_lab::registry::{Kernel, Prim, Visitor};
 use std::marker::PhantomData;
@@ -271,7 +274,7 @@ fn fallback_lanes<L: Lane<Scalar = f32>>(seed: u64) {
             .collect();
         let rp = RayPacket::<L>::from_rays(&rays);
         let mut cache = vec![FocalTriangle::never(); idx.len()];
-        let fm = mesh.focus(eye, &mut cache).unwrap();
+        let fm = raylane::focal::FocalMesh::new(&mesh, eye, &mut cache).unwrap();
         let fr = FocalRays::new(&rp);
         for i in 0..idx.len() {
             let t = mesh.triangle(i).unwrap();
@@ -416,7 +419,8 @@ where
         triangle::precompute_all::<K, L>(tris, &mut records),
         tris.len()
     );
-    let stored = triangle::closest_precomputed::<K, L>(&rp, &records, cull);
+    let stored =
+        raylane_lab::loops::closest_with(&rp, records.len(), |r, i| K::test(r, &records[i], cull));
     let fresh = internals::triangle::closest::<K, L>(&rp, tris, cull);
     for i in 0..rays.len() {
         assert_eq!(
@@ -443,7 +447,9 @@ fn focal_entry_points<L: Lane<Scalar = f32>>(
     let closest = internals::triangle::focal::closest::<L>(&rp, &cache, cull);
     let any = internals::triangle::focal::any::<L>(&rp, &cache, cull);
     let mut mcache = vec![FocalTriangle::never(); mesh.len()];
-    let fm = mesh.focus(eye, &mut mcache).unwrap().culled(cull);
+    let fm = raylane::focal::FocalMesh::new(mesh, eye, &mut mcache)
+        .unwrap()
+        .culled(cull);
     let m_closest = fm.closest(&rp);
     let m_any = fm.any(&rp);
     for (i, r) in rays.iter().enumerate() {
@@ -607,7 +613,7 @@ fn bad_input_is_a_miss() {
     assert!(mesh.closest(&r).mask.none());
     let mut cache = [FocalTriangle::never(); 3];
     assert!(
-        mesh.focus(down.origin(), &mut cache)
+        raylane::focal::FocalMesh::new(&mesh, down.origin(), &mut cache)
             .unwrap()
             .closest(&r)
             .mask
@@ -934,14 +940,14 @@ fn culling_never_loses_a_hit_and_saves_tests() {
     let fms: Vec<_> = bounded
         .iter()
         .zip(caches.iter_mut())
-        .map(|(b, c)| b.focus(eye, c).unwrap())
+        .map(|(b, c)| raylane::focal::FocalMesh::new(b, eye, c).unwrap())
         .collect();
     let mut pcaches: Vec<Vec<FocalTriangle<f32>>> =
         vec![vec![FocalTriangle::never(); tris_per_mesh]; plain.len()];
     let fps: Vec<_> = plain
         .iter()
         .zip(pcaches.iter_mut())
-        .map(|(p, c)| p.focus(eye, c).unwrap())
+        .map(|(p, c)| raylane::focal::FocalMesh::new(p, eye, c).unwrap())
         .collect();
     for r in &focal_rays {
         let fr = FocalRays::new(&RayPacket::<f32>::splat(r));

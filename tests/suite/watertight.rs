@@ -292,10 +292,14 @@ fn hits(m: Method, s: &Shape, ray: &Ray, cache: &mut [FocalTriangle<f32>]) -> Ve
         type Output = ();
         fn triangle<K: TriangleKernel>(self, _: Kernel) {
             let ray = self.rp.ray(0);
-            raylane::Query::all(&raylane::Using::<_, K>::new(self.mesh), &ray, self.push);
+            raylane::Query::all(
+                &raylane::set::Using::<_, K>::new(self.mesh),
+                &ray,
+                self.push,
+            );
         }
         fn focal_triangle(self, _: Kernel) {
-            if let Ok(fm) = self.mesh.focus(self.eye, self.cache) {
+            if let Ok(fm) = raylane::focal::FocalMesh::new(self.mesh, self.eye, self.cache) {
                 raylane::Query::all(&fm, &self.rp.ray(0), self.push);
             }
         }

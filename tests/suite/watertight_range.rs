@@ -60,10 +60,14 @@ fn leaks<K: TriangleKernel>(k: i32) -> (usize, usize) {
     for (ray, crossings) in &cases {
         let r = Ray::new(ray.origin() * s, ray.dir());
         let mut ts = Vec::new();
-        raylane::Query::all(&raylane::Using::<_, K>::new(&m), &r, |h: raylane::Hit| {
-            assert!(h.t.is_finite() && h.u.is_finite() && h.v.is_finite());
-            ts.push(h.t)
-        });
+        raylane::Query::all(
+            &raylane::set::Using::<_, K>::new(&m),
+            &r,
+            |h: raylane::Hit| {
+                assert!(h.t.is_finite() && h.u.is_finite() && h.v.is_finite());
+                ts.push(h.t)
+            },
+        );
         ts.sort_by(f32::total_cmp);
         // Distinct crossings: hits further apart than 1e-4 of the size (t is 1 to 6 sizes).
         let gap = 1e-4 * s;

@@ -98,7 +98,7 @@ pub fn render<L: Lane<Scalar = f32>>(
         let s = y as f32 / cam.height as f32;
         let sky = [0.16, 0.2, 0.28].map(|c| c * (1.0 - 0.5 * s));
         for x in (0..cam.width).step_by(L::LANES) {
-            let found = tree.closest_packet(&cam.row_packet::<L>(x, y));
+            let found = tree.closest(&cam.row_packet::<L>(x, y));
             for i in 0..L::LANES.min((cam.width - x) as usize) {
                 let c = match found.lane(i) {
                     Some(hit) => {

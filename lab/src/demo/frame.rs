@@ -4,10 +4,12 @@ use glam::Vec3;
 
 use super::{Camera, MAX_PARTS, Paint, Scene};
 use crate::registry::{Family, Kernel, Prim};
-use raylane::mesh::{FocalMesh, Mesh};
+use raylane::Cull;
+use raylane::focal::FocalMesh;
+use raylane::mesh::Mesh;
 use raylane::plane::{FocalPlane, Plane};
 use raylane::sphere::{FocalSphere, Sphere};
-use raylane::triangle::{Cull, FocalTriangle};
+use raylane::triangle::FocalTriangle;
 
 /// Caller storage for a frame's focal caches. Pinhole frames need one sphere entry per sphere
 /// (focal methods only), one plane entry per plane and one triangle entry per triangle of every
@@ -199,10 +201,7 @@ fn pieces<'a>(
                     .split_at_mut_checked(n)
                     .ok_or(SetupError::TriangleStorage)?;
                 store = rest;
-                Some(
-                    mesh.focus(e, head)
-                        .map_err(|_| SetupError::TriangleStorage)?,
-                )
+                Some(FocalMesh::new(&mesh, e, head).map_err(|_| SetupError::TriangleStorage)?)
             }
             None => None,
         };

@@ -49,7 +49,7 @@
 //! [`Pinhole::row_packet`]: raylane::camera::Pinhole::row_packet
 //! [`FocalSphere`]: raylane::sphere::FocalSphere
 //! [`FocalPlane`]: raylane::plane::FocalPlane
-//! [`FocalMesh`]: raylane::mesh::FocalMesh
+//! [`FocalMesh`]: raylane::focal::FocalMesh
 //! [`Mesh::bounded`]: raylane::mesh::Mesh::bounded
 
 pub mod bunny;

@@ -3,15 +3,17 @@
 use super::empty_sphere;
 use super::{Camera, Frame, ID_NONE, ID_PLANE, ID_SPHERE, ID_TRIANGLE, Stats, Tile};
 use crate::registry::{Kernel, Visitor};
-use raylane::hit;
+use raylane::Cull;
+use raylane::hit::{At, Closest, Collector, Hits, Winners};
 use raylane::lane::{Lane, MAX_LANES, Mask};
 use raylane::mesh::Mesh;
-use raylane::plane;
+use raylane::plane::FocalPlane;
 use raylane::ray::RayPacket;
-use raylane::sphere::focal::{self as sf, FocalKernel};
-use raylane::sphere::{self, FocalSphere, Sphere, SphereKernel};
+use raylane::set::{Trace, Using};
+use raylane::sphere::focal::{FocalKernel, Splat};
+use raylane::sphere::{FocalSphere, Sphere, SphereKernel, first_root};
 use raylane::triangle::focal::FocalRays;
-use raylane::triangle::{Cull, TriangleKernel, Watertight};
+use raylane::triangle::{TriangleKernel, Watertight};
 
 /// What is hit in each lane of a packet, merged over the kinds of primitive.
 #[derive(Clone, Copy, Debug)]
@@ -34,7 +36,7 @@ impl Best {
     }
 
     /// Takes the lanes of `h` that are strictly closer.
-    fn merge<L: Lane<Scalar = f32>>(&mut self, h: &hit::Best<L>, id: u8, part: u8) {
+    fn merge<L: Lane<Scalar = f32>>(&mut self, h: &Winners<L>, id: u8, part: u8) {
         let mut bits = h.mask.bits();
         while bits != 0 {
             let i = bits.trailing_zeros() as usize;
@@ -140,8 +142,8 @@ impl Frame<'_> {
             stats.plane_tests += k * self.scene.planes.len() as u64;
             let r = best.shrink(rays);
             let h = match self.camera {
-                Camera::Pinhole(_) => plane::closest_focal(&r, self.planes),
-                Camera::Ortho(_) => plane::closest(&r, self.scene.planes),
+                Camera::Pinhole(_) => closest_focal_planes(&r, self.planes),
+                Camera::Ortho(_) => closest_in(self.scene.planes, &r),
             };
             best.merge(&h, ID_PLANE, 0);
         }
@@ -154,7 +156,7 @@ impl Frame<'_> {
 
     /// The closest sphere hit with the frame's kernel.
     #[inline(never)]
-    fn spheres<L: Lane<Scalar = f32>>(&self, rays: &RayPacket<L>) -> hit::Best<L> {
+    fn spheres<L: Lane<Scalar = f32>>(&self, rays: &RayPacket<L>) -> Winners<L> {
         self.kernel.visit(SphereHits { frame: self, rays })
     }
 
@@ -172,13 +174,17 @@ impl Frame<'_> {
             let Some(piece) = piece else { break };
             let tris = k * piece.mesh.len() as u64;
             stats.bound_tests += k;
-            let h = match (&fr, &piece.focal) {
-                (Some(fr), Some(fm)) => fm.try_closest(fr, piece.cull),
-                _ => closest_triangles::<L>(&piece.mesh, r, piece.cull),
+            let keep = match (&fr, &piece.focal) {
+                (Some(fr), Some(fm)) => fm.may_hit(fr) & r.valid(),
+                _ => piece.mesh.may_hit(r) & r.valid(),
             };
-            let Some(h) = h else {
+            if keep.none() {
                 stats.triangle_tests_saved += tris;
                 continue;
+            }
+            let h = match &piece.focal {
+                Some(fm) if fr.is_some() => closest_in(&fm.culled(piece.cull), r),
+                _ => closest_triangles::<L>(&piece.mesh, r, piece.cull),
             };
             stats.triangle_tests += tris;
             best.merge(&h, ID_TRIANGLE, p as u8);
@@ -192,8 +198,8 @@ impl Frame<'_> {
         &self,
         rays: &RayPacket<L>,
         guarded: bool,
-    ) -> hit::Best<L> {
-        let mut best = hit::Best::<L>::miss();
+    ) -> Winners<L> {
+        let mut best = Closest::new(rays);
         raylane::lane::assert_fits::<L>();
         let mut entries = [empty_sphere(); MAX_LANES];
         for (j, s) in self.scene.spheres.iter().enumerate() {
@@ -206,20 +212,13 @@ impl Frame<'_> {
                 };
             }
             let cache = FocalSphere::<L>::gather(&entries[..L::LANES.min(MAX_LANES)]);
-            let h = K::roots(rays, &cache).first();
-            let take = h.mask & h.t.lt(best.t);
-            best.t = L::select(take, h.t, best.t);
-            best.mask = best.mask | take;
-            let mut bits = take.bits();
-            while bits != 0 {
-                let i = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                if let Some(slot) = best.index.as_mut().get_mut(i) {
-                    *slot = j as u32;
-                }
+            let r = rays.shrink(Mask::splat(true), best.t_max());
+            let h = first_root(&K::roots(&r, &cache), Cull::None);
+            if h.mask.any() {
+                best.offer(&h, at(j), no_records);
             }
         }
-        best
+        best.finish()
     }
 }
 
@@ -230,46 +229,99 @@ struct SphereHits<'f, 'a, L: Lane> {
 }
 
 impl<L: Lane<Scalar = f32>> Visitor for SphereHits<'_, '_, L> {
-    type Output = hit::Best<L>;
+    type Output = Winners<L>;
 
-    fn sphere<K: SphereKernel>(self, _: Kernel) -> hit::Best<L> {
+    fn sphere<K: SphereKernel>(self, _: Kernel) -> Winners<L> {
         closest_spheres::<K, L>(self.rays, self.frame.scene.spheres)
     }
 
-    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) -> hit::Best<L> {
+    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) -> Winners<L> {
         match self.frame.camera {
-            Camera::Pinhole(_) => sf::closest::<K, L>(self.rays, self.frame.spheres),
+            Camera::Pinhole(_) => closest_focal_spheres::<K, L>(self.rays, self.frame.spheres),
             Camera::Ortho(_) => self.frame.focal_per_ray::<K, L>(self.rays, guarded),
         }
     }
 
     // Not sphere kernels: `Frame::new` refuses them.
-    fn plane(self, _: Kernel) -> hit::Best<L> {
-        hit::Best::miss()
+    fn plane(self, _: Kernel) -> Winners<L> {
+        Closest::new(self.rays).finish()
     }
-    fn focal_plane(self, _: Kernel) -> hit::Best<L> {
-        hit::Best::miss()
+    fn focal_plane(self, _: Kernel) -> Winners<L> {
+        Closest::new(self.rays).finish()
     }
-    fn triangle<K: TriangleKernel>(self, _: Kernel) -> hit::Best<L> {
-        hit::Best::miss()
+    fn triangle<K: TriangleKernel>(self, _: Kernel) -> Winners<L> {
+        Closest::new(self.rays).finish()
     }
-    fn focal_triangle(self, _: Kernel) -> hit::Best<L> {
-        hit::Best::miss()
+    fn focal_triangle(self, _: Kernel) -> Winners<L> {
+        Closest::new(self.rays).finish()
     }
 }
 
-/// [`sphere::closest`] out of line.
-#[inline(never)]
-fn closest_spheres<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, s: &[Sphere]) -> hit::Best<L> {
-    sphere::closest::<K, L>(rays, s)
+/// Where candidate `j` of a flat loop comes from.
+fn at(j: usize) -> At {
+    At {
+        set: 0,
+        index: j as u32,
+        loc: j as u32,
+    }
 }
 
-/// [`Mesh::try_closest`] with [`Watertight`], out of line.
+/// A closest-hit loop makes no records of single candidates.
+fn no_records<L: Lane>(_: &Winners<L>) -> Hits<L> {
+    Hits::miss()
+}
+
+/// The closest hits of `rays` in `set`, before records are made.
+fn closest_in<T: Trace + ?Sized, L: Lane>(set: &T, rays: &RayPacket<L>) -> Winners<L> {
+    let mut c = Closest::new(rays);
+    set.trace(rays, 0, &mut c);
+    c.finish()
+}
+
+/// The spheres with kernel `K`, out of line.
 #[inline(never)]
-fn closest_triangles<L: Lane>(
-    mesh: &Mesh,
+fn closest_spheres<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, s: &[Sphere]) -> Winners<L> {
+    closest_in(&Using::<[Sphere], K>::new(s), rays)
+}
+
+/// Sphere cache entries (guarded or not) with the focal kernel `K`, out of line.
+#[inline(never)]
+fn closest_focal_spheres<K: FocalKernel, L: Lane>(
     rays: &RayPacket<L>,
-    cull: Cull,
-) -> Option<hit::Best<L>> {
-    mesh.try_closest::<Watertight, L>(rays, cull)
+    cache: &[FocalSphere<f32>],
+) -> Winners<L> {
+    let mut best = Closest::new(rays);
+    for (j, e) in cache.iter().enumerate() {
+        if K::candidate(rays, &Splat(e)).none() {
+            continue;
+        }
+        let r = rays.shrink(Mask::splat(true), best.t_max());
+        if let Some(x) = K::maybe_roots(&r, &Splat(e)) {
+            let h = first_root(&x, Cull::None);
+            if h.mask.any() {
+                best.offer(&h, at(j), no_records);
+            }
+        }
+    }
+    best.finish()
+}
+
+/// Plane cache entries for rays from their eye, out of line.
+#[inline(never)]
+fn closest_focal_planes<L: Lane>(rays: &RayPacket<L>, cache: &[FocalPlane]) -> Winners<L> {
+    let mut best = Closest::new(rays);
+    for (j, p) in cache.iter().enumerate() {
+        let r = rays.shrink(Mask::splat(true), best.t_max());
+        let h = p.intersect_lanes(&r);
+        if h.mask.any() {
+            best.offer(&h, at(j), no_records);
+        }
+    }
+    best.finish()
+}
+
+/// A mesh with [`Watertight`], culled by `cull`, out of line.
+#[inline(never)]
+fn closest_triangles<L: Lane>(mesh: &Mesh, rays: &RayPacket<L>, cull: Cull) -> Winners<L> {
+    closest_in(&Using::<Mesh, Watertight>::new(mesh).culled(cull), rays)
 }

@@ -2,12 +2,12 @@
 
 use glam::Vec3;
 
+use raylane::Cull;
 use raylane::camera::Pinhole;
 use raylane::lane::{Lane, sqrt_f32};
 use raylane::plane::Plane;
 use raylane::ray::RayPacket;
 use raylane::sphere::Sphere;
-use raylane::triangle::Cull;
 use raylane::vec3::V3;
 
 /// How a surface is coloured (linear RGB in `[0, 1]`, lit by the scene's light).

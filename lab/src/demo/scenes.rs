@@ -22,10 +22,10 @@ use super::scene::unit;
 use super::shapes;
 use super::{Camera, Ortho, Paint, Part, Scene};
 use crate::registry::Kernel;
+use raylane::Cull;
 use raylane::camera::Pinhole;
 use raylane::plane::Plane;
 use raylane::sphere::Sphere;
-use raylane::triangle::Cull;
 
 /// Direction towards the light of the lit scenes (unit length up to rounding).
 pub const LIGHT: Vec3 = Vec3::new(-0.48, 0.8, 0.36);

@@ -11,7 +11,7 @@
 //!
 //! Every vertex shared by several triangles is stored once and referenced by index, and every
 //! triangle is wound counter-clockwise seen from outside (`(B − A) × (C − A)` points out), so
-//! back-face culling ([`Cull::Back`](raylane::triangle::Cull)) keeps the outside. Positions are
+//! back-face culling ([`Cull::Back`](raylane::Cull)) keeps the outside. Positions are
 //! computed in `f64` with correctly rounded operations only (`libm::sqrt` included), then
 //! rounded once to `f32`: the same bits on every target.
 

@@ -15,15 +15,16 @@
 
 use core::hint::black_box;
 
-use raylane::internals;
-use raylane::internals::Best;
+use raylane::Cull;
 use raylane::plane::{FocalPlane, Plane};
 use raylane::sphere::focal::{Focal, FocalUnguarded};
 use raylane::sphere::{FocalSphere, Geometric, Quadratic, QuadraticUnit, Robust, Sphere};
-use raylane::triangle::{Cramer, Cull, FocalTriangle, Moller, Triangle, Watertight};
+use raylane::triangle::{Cramer, FocalTriangle, Moller, Triangle, Watertight};
 use raylane::{Mask, Ray, RayPacket};
 use raylane_fw::semihosting::hprintln;
 use raylane_fw::{entry, exit};
+use raylane_lab::loops as internals;
+use raylane_lab::loops::Best;
 
 raylane_fw::panic_exits!();
 

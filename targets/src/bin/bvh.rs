@@ -56,7 +56,7 @@ mod device {
     const H: u32 = bunny::SIZE.1;
     const PIXELS: usize = (W * H) as usize;
     const N: usize = bunny::TRIANGLES;
-    const SIZES: bvh::Sizes = bvh::needed(N);
+    const SIZES: bvh::Sizes = bvh::TriangleBvh::needed(N);
 
     /// Where the image goes on the host (NUL-terminated for SYS_OPEN).
     const PATH: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/target/bvh.ppm\0");
@@ -139,7 +139,7 @@ mod device {
         let mut leaves = [<Tri4 as Packed>::EMPTY; SIZES.leaves];
         let mut scratch = [Scratch::default(); SIZES.scratch];
         bvh_begin();
-        let built = bvh::build(&tris[..n], &mut nodes, &mut leaves, &mut scratch);
+        let built = bvh::Bvh::build(&tris[..n], &mut nodes, &mut leaves, &mut scratch);
         bvh_end();
         let tree = match built {
             Ok(t) => t,

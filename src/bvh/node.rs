@@ -1,0 +1,381 @@
+//! Node layouts: how a node keeps its children's boxes and references, and how rays test
+//! them. The traversal ([`super::traverse`]) is written once over the [`Layout`] trait; a new
+//! layout (4-wide, quantized boxes) is a new type implementing it, not a new loop.
+//!
+//! **Conservative, not exact.** A node test only decides which children a ray may enter: the
+//! hits come from the leaf kernels and the collector's tie rule ([`crate::hit`]), so a layout
+//! may widen boxes, quantize them outward or test children in any order without changing an
+//! answer, as long as it never rejects a child whose box the ray's interval meets. [`Node`]
+//! widens every box by the margin of the [module docs](super) and tests them with plain
+//! IEEE operations; packets whose directions share their signs test all children at once by
+//! interval arithmetic ([`Frustum`]), conservative by monotonic rounding.
+
+use glam::Vec3;
+use wide::f32x8;
+
+use super::{EMPTY, WIDTH};
+use crate::lane::{Lane, Mask, Scalar};
+use crate::ray::RayPacket;
+
+/// A node layout (see the [module docs](self)).
+pub trait Layout: Copy + core::fmt::Debug {
+    /// A node with no children.
+    const EMPTY: Self;
+    /// Child `k`'s reference: [`EMPTY`], `LEAF | leaf index`, or an inner node's index.
+    fn child(&self, k: usize) -> u32;
+    /// Child `k`'s box (`min > max` for an empty slot).
+    fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]);
+    /// One ray: bit `k` set when its interval `(t_min, t_max)` meets child `k`'s box, and the
+    /// entry parameters per child.
+    fn test_one(&self, slab: &Slab, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]);
+    /// A packet whose directions share their signs: bit `k` set when some lane may enter
+    /// child `k` within `(t_lo, t_hi)`, and lower bounds of the lanes' entry parameters.
+    fn test_frustum(&self, f: &Frustum, t_lo: f32, t_hi: f32) -> (u32, [f32; WIDTH]);
+    /// A packet against child `k`: the lanes of `active` whose interval meets its box, and
+    /// their entry parameters.
+    fn test_lanes<L: Lane>(
+        &self,
+        slab: &PacketSlab<L>,
+        k: usize,
+        t_min: L,
+        t_max: L,
+        active: L::Mask,
+    ) -> (L::Mask, L);
+}
+
+/// One inner node of 8 children, their boxes in structure-of-arrays lanes: one `f32x8` slab
+/// test per ray tests them all.
+///
+/// `bounds[0..3]` are the children's minimum x, y, z, `bounds[3..6]` their maximum x, y, z
+/// (`bounds[axis][k]` is child `k`'s). Unused slots have `min = +inf`, `max = −inf` and
+/// `child = EMPTY`. 224 bytes, aligned to 32.
+#[repr(C, align(32))]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Node {
+    /// Children's boxes: min x, y, z, then max x, y, z; lane `k` is child `k`.
+    pub bounds: [[f32; WIDTH]; 6],
+    /// Children: [`EMPTY`], `LEAF | leaf index`, or an inner node's index (greater than this
+    /// node's).
+    pub child: [u32; WIDTH],
+}
+
+impl Node {
+    /// A node with no children.
+    pub const EMPTY: Node = Node {
+        bounds: [
+            [f32::INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+            [f32::NEG_INFINITY; WIDTH],
+        ],
+        child: [EMPTY; WIDTH],
+    };
+}
+
+impl Default for Node {
+    fn default() -> Self {
+        Node::EMPTY
+    }
+}
+
+impl Layout for Node {
+    const EMPTY: Self = Node::EMPTY;
+
+    #[inline(always)]
+    fn child(&self, k: usize) -> u32 {
+        self.child.get(k).copied().unwrap_or(EMPTY)
+    }
+
+    #[inline]
+    fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]) {
+        let b = &self.bounds;
+        let get = |a: usize| b[a].get(k).copied().unwrap_or(f32::NAN);
+        ([get(0), get(1), get(2)], [get(3), get(4), get(5)])
+    }
+
+    #[inline(always)]
+    fn test_one(&self, slab: &Slab, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+        slab.test(&self.bounds, &self.child, t_min, t_max)
+    }
+
+    #[inline(always)]
+    fn test_frustum(&self, f: &Frustum, t_lo: f32, t_hi: f32) -> (u32, [f32; WIDTH]) {
+        f.test(&self.bounds, t_lo, t_hi)
+    }
+
+    #[inline(always)]
+    fn test_lanes<L: Lane>(
+        &self,
+        slab: &PacketSlab<L>,
+        k: usize,
+        t_min: L,
+        t_max: L,
+        active: L::Mask,
+    ) -> (L::Mask, L) {
+        slab.test(&self.bounds, k, t_min, t_max, active)
+    }
+}
+
+/// The box widening relative to `R + |o|∞`: `2^-17` (see the [module docs](super) for why it
+/// is conservative).
+pub(crate) const MARGIN: f32 = 1.0 / 131072.0;
+/// The largest `R + |o|∞` the slab test handles (`2^100`); beyond it every child is visited.
+const FAR: f32 = 1.2676506e30;
+/// Inverse direction components are clamped to `±2^100` (a zero component gives `±2^100`).
+const INV_MAX: f32 = 1.2676506e30;
+/// `|d|∞` must lie in `2^-64…2^64` for the slab test; outside, every child is visited.
+const D_LO: f32 = 5.421011e-20;
+const D_HI: f32 = 1.8446744e19;
+
+/// The per-ray constants of the slab test, for one ray: which plane is near on each axis
+/// (a row of [`Node::bounds`]), the two widened origins and the clamped inverse direction.
+#[derive(Clone, Copy, Debug)]
+pub struct Slab {
+    near: [usize; 3],
+    far: [usize; 3],
+    on: [f32; 3],
+    of: [f32; 3],
+    inv: [f32; 3],
+    /// Visit every non-empty child (the slab test's range is exceeded).
+    all: bool,
+}
+
+impl Slab {
+    #[inline(always)]
+    pub(crate) fn new(o: Vec3, d: Vec3, reach: f32) -> Self {
+        let (o, d) = (o.to_array(), d.to_array());
+        let omax = o[0].abs().max(o[1].abs()).max(o[2].abs());
+        let dmax = d[0].abs().max(d[1].abs()).max(d[2].abs());
+        let span = reach + omax;
+        let all = !(span <= FAR && (D_LO..=D_HI).contains(&dmax));
+        let m = span * MARGIN;
+        let mut s = Slab {
+            near: [0, 1, 2],
+            far: [3, 4, 5],
+            on: [0.0; 3],
+            of: [0.0; 3],
+            inv: [0.0; 3],
+            all,
+        };
+        for a in 0..3 {
+            // `+ 0` makes −0 positive, so the plane choice and the inverse's sign agree.
+            let da = d[a] + 0.0;
+            let neg = da < 0.0;
+            s.inv[a] = (1.0 / da).clamp(-INV_MAX, INV_MAX);
+            // Arithmetic rather than branches or selects (which the compiler may turn into
+            // branches): the sign of an incoherent ray's direction is unpredictable. `ms` is
+            // `±m` (a sign flip, exact), so `o + ms` and `o − ms` are `o ± m` bit for bit.
+            let k = neg as usize;
+            let ms = f32::from_bits(m.to_bits() ^ ((neg as u32) << 31));
+            s.near[a] = a + 3 * k;
+            s.far[a] = 3 + a - 3 * k;
+            s.on[a] = o[a] + ms;
+            s.of[a] = o[a] - ms;
+        }
+        s
+    }
+
+    /// Bit `k` set when the ray's interval `(t_min, t_max)` meets the widened box of child `k`
+    /// (rows `b`: minimum x, y, z, maximum x, y, z; `[row][child]`), and the entry parameters
+    /// per child; `child` marks the empty slots ([`EMPTY`]) for rays that visit every child.
+    #[inline(always)]
+    pub fn test(
+        &self,
+        b: &[[f32; WIDTH]; 6],
+        child: &[u32; WIDTH],
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, [f32; WIDTH]) {
+        if self.all {
+            let mut bits = 0;
+            for (k, &c) in child.iter().enumerate() {
+                if c != EMPTY {
+                    bits |= 1 << k;
+                }
+            }
+            return (bits, [t_min; WIDTH]);
+        }
+        let plane = |p: usize, o: f32, inv: f32| (f32x8::new(b[p]) - f32x8::splat(o)) * inv;
+        let tn = f32x8::splat(t_min)
+            .fast_max(plane(self.near[0], self.on[0], self.inv[0]))
+            .fast_max(plane(self.near[1], self.on[1], self.inv[1]))
+            .fast_max(plane(self.near[2], self.on[2], self.inv[2]));
+        let tf = f32x8::splat(t_max)
+            .fast_min(plane(self.far[0], self.of[0], self.inv[0]))
+            .fast_min(plane(self.far[1], self.of[1], self.inv[1]))
+            .fast_min(plane(self.far[2], self.of[2], self.inv[2]));
+        (tn.simd_le(tf).to_bitmask(), tn.to_array())
+    }
+}
+
+/// The per-lane constants of the slab test for a packet (as [`Slab`], lane by lane).
+#[derive(Clone, Copy, Debug)]
+pub struct PacketSlab<L: Lane> {
+    neg: [L::Mask; 3],
+    on: [L; 3],
+    of: [L; 3],
+    inv: [L; 3],
+    all: L::Mask,
+}
+
+#[inline(always)]
+pub(crate) fn lmax<L: Lane>(a: L, b: L) -> L {
+    L::select(b.gt(a), b, a)
+}
+
+#[inline(always)]
+pub(crate) fn lmin<L: Lane>(a: L, b: L) -> L {
+    L::select(b.lt(a), b, a)
+}
+
+impl<L: Lane> PacketSlab<L> {
+    pub(crate) fn new(rays: &RayPacket<L>, reach: f32) -> Self {
+        let (o, d) = (rays.origin, rays.dir);
+        let omax = lmax(lmax(o.x.abs(), o.y.abs()), o.z.abs());
+        let dmax = lmax(lmax(d.x.abs(), d.y.abs()), d.z.abs());
+        let span = L::from_f32(reach) + omax;
+        let ok =
+            span.le(L::from_f32(FAR)) & dmax.ge(L::from_f32(D_LO)) & dmax.le(L::from_f32(D_HI));
+        let m = span * L::from_f32(MARGIN);
+        let (ov, dv) = ([o.x, o.y, o.z], [d.x, d.y, d.z]);
+        let zero = L::from_f32(0.0);
+        let neg = dv.map(|x| (x + zero).lt(zero));
+        let inv = dv.map(|x| {
+            let i = L::from_f32(1.0) / (x + zero);
+            lmax(lmin(i, L::from_f32(INV_MAX)), L::from_f32(-INV_MAX))
+        });
+        let on = core::array::from_fn(|a| L::select(neg[a], ov[a] - m, ov[a] + m));
+        let of = core::array::from_fn(|a| L::select(neg[a], ov[a] + m, ov[a] - m));
+        PacketSlab {
+            neg,
+            on,
+            of,
+            inv,
+            all: !ok,
+        }
+    }
+
+    /// Lanes of `active` whose interval meets child `k`'s widened box (rows `b`, as
+    /// [`Slab::test`]), and their entry parameters.
+    #[inline(always)]
+    pub fn test(
+        &self,
+        b: &[[f32; WIDTH]; 6],
+        k: usize,
+        t_min: L,
+        t_max: L,
+        active: L::Mask,
+    ) -> (L::Mask, L) {
+        let p = |i: usize| L::from_f32(b[i][k]);
+        let mut tn = t_min;
+        let mut tf = t_max;
+        for a in 0..3 {
+            let (lo, hi) = (p(a), p(3 + a));
+            let near = L::select(self.neg[a], hi, lo);
+            let far = L::select(self.neg[a], lo, hi);
+            tn = lmax(tn, (near - self.on[a]) * self.inv[a]);
+            tf = lmin(tf, (far - self.of[a]) * self.inv[a]);
+        }
+        ((tn.le(tf) | self.all) & active, tn)
+    }
+}
+
+/// A packet's slab constants as intervals over its valid lanes, for packets whose directions
+/// share their sign on every axis (and whose lanes all pass the slab test's range checks):
+/// one `f32x8` interval test per node tests all 8 children for the whole packet.
+///
+/// Each lane's entry on an axis is `fl(fl(p − o_i)·v_i)`, with the near plane `p` the same
+/// for every lane (the signs agree). Rounding is monotonic, so `fl(p − o_i)` lies between
+/// `fl(p − max o)` and `fl(p − min o)`, and `fl(x·v_i)` between the rounded products of the
+/// interval's corners: with `v > 0` the lowest entry is `min(x_lo·v_min, x_lo·v_max)`, with
+/// `v < 0` `min(x_hi·v_min, x_hi·v_max)`, and the exits likewise from above. So a child some
+/// lane's own slab test enters passes the interval test (never the converse: a pass only
+/// means "look closer"), and every answer stays the per-lane traversal's.
+#[derive(Clone, Copy, Debug)]
+pub struct Frustum {
+    near: [usize; 3],
+    far: [usize; 3],
+    /// Per axis: the near origins' (min, max), the far origins' (min, max), the inverse
+    /// directions' (min, max), and whether they are negative.
+    on: [(f32, f32); 3],
+    of: [(f32, f32); 3],
+    inv: [(f32, f32); 3],
+    neg: [bool; 3],
+}
+
+impl Frustum {
+    /// The intervals of the `valid` lanes of `s`, or `None` when their directions' signs
+    /// differ on some axis or a lane visits every child.
+    pub(crate) fn new<L: Lane>(s: &PacketSlab<L>, valid: L::Mask) -> Option<Frustum> {
+        if (s.all & valid).any() || valid.none() {
+            return None;
+        }
+        let mut f = Frustum {
+            near: [0, 1, 2],
+            far: [3, 4, 5],
+            on: [(0.0, 0.0); 3],
+            of: [(0.0, 0.0); 3],
+            inv: [(0.0, 0.0); 3],
+            neg: [false; 3],
+        };
+        // Lanes with a non-finite constant take the per-child test (the ranges skip NaN).
+        let finite = |x: L| valid.and_not(x.is_finite()).none();
+        if !(0..3).all(|a| finite(s.on[a]) && finite(s.of[a]) && finite(s.inv[a])) {
+            return None;
+        }
+        let range = |x: L| (-highest(-x, valid), highest(x, valid));
+        for a in 0..3 {
+            let neg = s.neg[a] & valid;
+            if neg.any() && valid.and_not(neg).any() {
+                return None;
+            }
+            f.neg[a] = neg.any();
+            if f.neg[a] {
+                f.near[a] = 3 + a;
+                f.far[a] = a;
+            }
+            f.on[a] = range(s.on[a]);
+            f.of[a] = range(s.of[a]);
+            f.inv[a] = range(s.inv[a]);
+        }
+        Some(f)
+    }
+
+    /// Bit `k` set when some lane may enter child `k` of the rows `b` within `(t_lo, t_hi)`
+    /// (the lanes' lowest `t_min` and highest `t_max`); lower bounds of the lanes' entry
+    /// parameters.
+    #[inline(always)]
+    pub fn test(&self, b: &[[f32; WIDTH]; 6], t_lo: f32, t_hi: f32) -> (u32, [f32; WIDTH]) {
+        let mut tn = f32x8::splat(t_lo);
+        let mut tf = f32x8::splat(t_hi);
+        for a in 0..3 {
+            let (near, far) = (f32x8::new(b[self.near[a]]), f32x8::new(b[self.far[a]]));
+            let (vl, vh) = self.inv[a];
+            // The near planes' lowest and the far planes' highest offsets that matter.
+            let (x, y) = if self.neg[a] {
+                (near - self.on[a].0, far - self.of[a].1)
+            } else {
+                (near - self.on[a].1, far - self.of[a].0)
+            };
+            tn = tn.fast_max((x * vl).fast_min(x * vh));
+            tf = tf.fast_min((y * vl).fast_max(y * vh));
+        }
+        (tn.simd_le(tf).to_bitmask(), tn.to_array())
+    }
+}
+
+/// The highest value of the `valid` lanes (none NaN: valid rays have no NaN constants).
+#[inline(always)]
+pub(crate) fn highest<L: Lane>(t: L, valid: L::Mask) -> f32 {
+    let t = L::select(valid, t, L::from_f32(f32::NEG_INFINITY));
+    let mut r = f32::NEG_INFINITY;
+    for i in 0..L::LANES {
+        let v = t.lane(i).to_f64() as f32;
+        if v > r {
+            r = v;
+        }
+    }
+    r
+}
