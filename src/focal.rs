@@ -9,8 +9,8 @@
 //! **One contract.** A focal set answers every ray. Rays from its eye (origin equal to `E`,
 //! bit for bit; for spheres also with a unit direction, `||d|² − 1| ≤ 2^-20`) are answered by
 //! the focal kernel; every other ray, or lane of a packet, is answered by the set it was
-//! made from with that set's default kernel ([`Watertight`](crate::triangle::Watertight),
-//! [`Robust`](crate::sphere::Robust), the plane test), the same bits as asking that set. Both
+//! made from with that set's default kernel ([`Watertight`], [`Robust`], the plane test), the
+//! same bits as asking that set. Both
 //! follow the same interval, tie rule and records ([`crate::hit`]).
 //!
 //! **Storage.** `needed(set)` says how many entries the cache needs; `new(set, eye, storage)`

@@ -122,7 +122,7 @@ pub trait Primitive: Copy {
 }
 
 /// A kernel of primitive `P`: the one trait through which every set calls its kernels, and
-/// the type parameter of a query's [`using`](crate::query::Set::using) (which accepts only
+/// the type parameter of a query's [`using`](crate::Query::using) (which accepts only
 /// kernels of the set's primitive).
 ///
 /// Implemented by every sphere kernel ([`SphereKernel`](crate::sphere::SphereKernel)), every

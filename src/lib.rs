@@ -18,11 +18,12 @@
 //! * A ray is `o + t·d` over an open interval: a hit needs `t_min < t < t_max`
 //!   ([`Ray::new`] uses `(0, +inf)`). `t` is in units of `|d|`.
 //! * Directions need not be unit length, except for the methods that say so:
-//!   [`sphere::QuadraticUnit`], [`sphere::Geometric`] and the sphere focal caches
-//!   ([`sphere::focal`]). Those normalise nothing.
+//!   [`sphere::QuadraticUnit`], [`sphere::Geometric`] and the sphere focal kernels
+//!   ([`sphere::focal`]). Those normalise nothing; through a query, other rays are a miss for
+//!   the first two and are answered in world mode by [`focal::FocalSpheres`].
 //! * Sphere kernels return every root inside the interval, ascending.
 //! * Triangle hits carry barycentrics: `u` weighs vertex B, `v` vertex C. Triangles are
-//!   two-sided unless back faces are culled ([`triangle::Cull`]); the `watertight` and `focal`
+//!   two-sided unless back faces are culled ([`Cull`]); the `watertight` and `focal`
 //!   kernels never let a ray slip between triangles that share an edge or a vertex.
 //! * Misses are canonical: `t = +inf`, index `u32::MAX`; no hit record ever holds a NaN.
 //!

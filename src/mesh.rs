@@ -12,10 +12,10 @@
 //! A mesh with more invalid triangles than that re-checks each triangle per query (correct,
 //! slower; [`Mesh::invalid`] says how many there are). The focal cache is built once per eye.
 //!
-//! Queries ([`Query`]): `mesh.closest(&ray)`, `mesh.any(&packet)`, `mesh.all(..)` with the
-//! default kernel ([`Watertight`](crate::triangle::Watertight), two-sided), or
-//! `mesh.using::<K>()` for any other triangle kernel, culled with
-//! [`Using::culled`] ([`Cull`]); N rays × 1 triangle, in index order.
+//! Queries ([`Query`](crate::Query)): `mesh.closest(&ray)`, `mesh.any(&packet)`,
+//! `mesh.all(..)` with the default kernel ([`Watertight`], two-sided), or `mesh.using::<K>()`
+//! for any other triangle kernel and `.culled(Cull::Back)` for front faces only; N rays × 1
+//! triangle, in index order.
 //!
 //! ```
 //! use raylane::glam::Vec3;
@@ -29,12 +29,10 @@
 //! assert_eq!((hit.t, hit.u, hit.normal, hit.front), (5.0, 0.25, Vec3::Z, true));
 //! ```
 //!
-//! **Culling.** [`Mesh::bounded`] adds a bounding sphere ([`bounds`]); each
-//! query first asks [`Bound::may_hit`], and lanes it rejects are not tested (their interval
-//! is emptied, so every lane width gives the scalar answer). For rays from one eye,
-//! [`Mesh::focus`] builds the focal cache ([`FocalTriangle`]) into caller storage (too little
-//! is an error, [`Mesh::needed`] says how much), with the bound as a [`FocalSphere`] tested
-//! first; the [`FocalMesh`] owns its eye.
+//! **Culling.** [`Mesh::bounded`] adds a bounding sphere ([`bounds`]); each query first asks
+//! [`Bound::may_hit`], and lanes it rejects are not tested (their interval is emptied, so every
+//! lane width gives the scalar answer). For rays from one eye,
+//! [`FocalMesh`](crate::focal::FocalMesh) caches the triangles, with the bound tested first.
 
 use glam::Vec3;
 
@@ -201,8 +199,7 @@ impl<'a> Mesh<'a> {
 }
 
 /// Meshes: the bounding sphere first (lanes it excludes are not tested), then N rays × 1
-/// triangle in index order; `all` in index order. Default kernel:
-/// [`Watertight`](crate::triangle::Watertight), two-sided.
+/// triangle in index order; `all` in index order. Default kernel: [`Watertight`], two-sided.
 impl Set for Mesh<'_> {
     type Prim = Triangle;
     type Kernel = Watertight;

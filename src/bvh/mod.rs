@@ -4,9 +4,9 @@
 //!
 //! # Build
 //!
-//! [`needed`] gives the storage for `n` primitives; [`build`] writes the tree into the caller's
-//! slices ([`Node`]s, leaves, [`Scratch`]) and returns a [`Bvh`] that borrows them: no
-//! allocation, no recursion, `no_std`. Short storage is an error value ([`BuildError`]).
+//! [`Bvh::needed`] gives the storage for `n` primitives; [`Bvh::build`] writes the tree into the
+//! caller's slices ([`Node`]s, leaves, [`Scratch`]) and returns a [`Bvh`] that borrows them:
+//! no allocation, no recursion, `no_std`. Short storage is an error value ([`BuildError`]).
 //!
 //! * **Binned SAH** (Wald, "On fast Construction of SAH-based Bounding Volume Hierarchies",
 //!   2007): primitive centroids in 16 bins per axis (all three axes in one pass), a sweep over
@@ -26,7 +26,8 @@
 //! * **Bad input.** A primitive that no kernel can hit (NaN or infinite coordinates, zero area,
 //!   non-positive radius) gets an empty box and is never visited; coincident primitives are
 //!   split by index; nothing panics or loops.
-//! * [`refit`] recomputes every box after vertices move (same topology, same leaves).
+//! * [`Bvh::refit`] recomputes every box after vertices move (same topology, same leaves,
+//!   the same number of primitives).
 //!
 //! # Scenes
 //!
@@ -45,17 +46,19 @@
 //!
 //! # Traversal and exactness
 //!
-//! A [`Bvh`] implements [`Query`](crate::Query): `closest`, `any`, `all` for one [`Ray`](crate::Ray)
-//! (children in lanes: one `f32x8` slab test per node, nearest child first; leaves with one
-//! `f32x4` kernel call: 1 ray × 4 primitives) or a [`RayPacket`](crate::RayPacket) of any width (1, 4, 8, 16
-//! rays, inactive lanes masked; N rays × 1 primitive in the leaves). A packet whose
-//! directions share their signs tests all 8 children of a node at once, for the whole packet,
-//! with interval bounds of its lanes' slab values (conservative because rounding is
-//! monotonic; a leaf child is then checked lane by lane); other packets test one child box
-//! per lane operation. Triangles use [`Watertight`](crate::triangle::Watertight), spheres
-//! [`Robust`](crate::sphere::Robust), two-sided unless [`Bvh::with_cull`] says otherwise.
-//! [`Bvh::focus`] gives the focal mode for rays from one eye ([`focal`]: per-eye planes and
-//! leaf vertices, the same answers).
+//! A [`Bvh`] is a set like any other ([`Query`](crate::Query)): `closest`, `any`, `all` for
+//! one [`Ray`] (children in lanes: one `f32x8` slab test per node, nearest child
+//! first; leaves with one `f32x4` kernel call: 1 ray × 4 primitives) or a
+//! [`RayPacket`] of any width (1, 4, 8, 16 rays, inactive lanes masked;
+//! N rays × 1 primitive in the leaves). A packet whose directions share their signs tests all
+//! 8 children of a node at once, for the whole packet, with interval bounds of its lanes'
+//! slab values (conservative because rounding is monotonic; a leaf child is then checked lane
+//! by lane); other packets test one child box per lane operation. Triangles use
+//! [`Watertight`](crate::triangle::Watertight), spheres [`Robust`](crate::sphere::Robust),
+//! two-sided, unless the query names another kernel or culls:
+//! `tree.using::<Moller>().culled(Cull::Back)`, exactly as on a slice. The traversal is one
+//! loop per ray shape (`traverse.rs`), generic over the node [`Layout`], the leaf (kernels
+//! over [`Tri4`]/[`Sphere4`], or [`Instance`]s) and the collector ([`crate::hit`]).
 //!
 //! ```
 //! use raylane::bvh::{Bvh, Node, Packed, Scratch, Tri4, TriangleBvh};
@@ -84,9 +87,9 @@
 //! ties to the lowest primitive index, with the same `t`, `u`, `v`, index bits (and so the same
 //! point, normal and face), whatever order the tree is visited in. Two things make it so:
 //!
-//! 1. **Lexicographic merge.** A candidate wins on `(t, index)`, and `t_max` is relaxed to
-//!    `t + |t|·2^-21` after each hit exactly as the brute-force loops do ([`crate::hit`]), so a
-//!    kernel's pre-division test never drops a would-be winner.
+//! 1. **One tie rule.** A candidate wins on `(t, set, index)`, and kernels are asked with
+//!    `t_max` relaxed after each hit, by the collector that brute force uses too
+//!    ([`crate::hit`]), so a kernel's pre-division test never drops a would-be winner.
 //! 2. **Conservative boxes** (in the spirit of Ize, "Robust BVH Ray Traversal", JCGT 2013).
 //!    Each box is widened by `m = 2^-17·(R + |o|∞)`, with `R` the largest coordinate in the
 //!    tree and `o` the ray's origin: the Watertight kernel's edge tests and `t` are exact up to
@@ -105,11 +108,9 @@
 //!    whose `|d|∞` lies outside `2^-64…2^64` or whose `R + |o|∞` exceeds `2^100` visit every
 //!    non-empty child (still exact, only slower).
 //!
-//! **One boundary case.** The brute-force loops test the first triangle with the ray's own
-//! `t_max`; this traversal starts from the relaxed `t_max` and keeps hits with `t < t_max`. The
-//! two differ only for a triangle whose rounded `t` lies within one rounding of a *finite*
-//! `t_max` and whose pre-division product rounds onto it, where brute force's answer depends
-//! on the triangles' order; rays with `t_max = +inf` are never affected.
+//! The interval is decided by the collector alone — a hit counts when its rounded `t` lies in
+//! `(t_min, t_max)` — so the tree and brute force agree for every `t_max`, finite or not, and
+//! `any`, `all` and `closest` agree with each other.
 
 mod build;
 mod leaf;

@@ -1,5 +1,5 @@
 //! Node layouts: how a node keeps its children's boxes and references, and how rays test
-//! them. The traversal ([`super::traverse`]) is written once over the [`Layout`] trait; a new
+//! them. The traversal (`traverse.rs`) is written once over the [`Layout`] trait; a new
 //! layout (4-wide, quantized boxes) is a new type implementing it, not a new loop.
 //!
 //! **Conservative, not exact.** A node test only decides which children a ray may enter: the

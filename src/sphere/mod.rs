@@ -16,7 +16,7 @@
 //!
 //! Ask through [`Query`](crate::Query): `spheres.closest(&ray)` (default kernel [`Robust`]),
 //! `spheres.using::<Geometric>().any(&packet)`; rays from one eye through the focal cache
-//! [`FocalSpheres`](focal::FocalSpheres).
+//! [`FocalSpheres`](crate::focal::FocalSpheres).
 //!
 //! Bad input: a sphere with a non-finite centre or a radius that is not a finite positive
 //! number is stored with a NaN radius by [`Sphere::new`] and never hit; bad rays are

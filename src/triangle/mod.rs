@@ -46,7 +46,7 @@
 //!
 //! **Asking.** Through [`Query`](crate::Query): `tris.closest(&ray)` (default kernel
 //! [`Watertight`]), `tris.using::<Moller>().any(&packet)`; meshes over shared vertex slices are
-//! in [`mesh`](crate::mesh), with their focal cache [`FocalMesh`](crate::mesh::FocalMesh).
+//! in [`mesh`](crate::mesh), with their focal cache [`FocalMesh`](crate::focal::FocalMesh).
 //!
 //! **Bad input.** [`Triangle::new`] stores a triangle with a non-finite coordinate or exactly
 //! zero area (collinear vertices, decided exactly) with NaN vertices, and every kernel misses
