@@ -67,15 +67,19 @@ RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p raylane -p raylane-lab
 
 step "library builds: host, AArch64 and every embedded target; the lab beside it"
 for t in x86_64-unknown-linux-gnu aarch64-unknown-linux-gnu "${embedded[@]}"; do
-  cargo build --quiet --lib --target "$t" --no-default-features --target-dir target/matrix \
-    || fail "the library does not build for $t"
+  for f in "" alloc; do
+    cargo build --quiet --lib --target "$t" --no-default-features ${f:+--features "$f"} \
+      --target-dir target/matrix || fail "the library does not build for $t with features [$f]"
+  done
   cargo build --quiet --lib --target "$t" -p raylane-lab --target-dir target/matrix \
     || fail "the lab does not build for $t"
-  echo "$t: the library (no default features) and the lab build"
+  echo "$t: the library (no default features, alloc) and the lab build"
 done
 
 step "MSRV: the library built and tested with Rust $msrv"
-cargo "+$msrv" build --quiet --lib --no-default-features --target-dir target/msrv
+for f in "" alloc; do
+  cargo "+$msrv" build --quiet --lib --no-default-features ${f:+--features "$f"} --target-dir target/msrv
+done
 cargo "+$msrv" test --quiet -p raylane --target-dir target/msrv \
   > target/msrv.log 2>&1 || { cat target/msrv.log; fail "the tests fail with Rust $msrv"; }
 grep -E '^test result' target/msrv.log | sed "s/^/rust $msrv: /"

@@ -131,9 +131,8 @@ impl<L: Lane> Hits<L> {
 
     /// Writes one ray's record into lane `i` (a miss clears it).
     #[inline]
-    pub fn set_lane(&mut self, i: usize, h: Option<&Hit>) {
+    pub(crate) fn set_lane(&mut self, i: usize, h: Option<&Hit>) {
         let s = |x: f32| L::Scalar::from_f32(x);
-        let m = Self::miss();
         let h = match h {
             Some(h) => *h,
             None => Hit {
@@ -168,7 +167,6 @@ impl<L: Lane> Hits<L> {
         if let Some(x) = self.set.as_mut().get_mut(i) {
             *x = h.set;
         }
-        let _ = m;
     }
 }
 
@@ -258,6 +256,9 @@ pub trait Collector<L: Lane> {
     /// True when every hit is wanted (a sphere's exit roots too), not only the first per
     /// primitive; such a traversal cannot be restarted.
     const EVERY: bool = false;
+    /// True when [`t_max`](Self::t_max) shrinks as hits are found (a traversal then prunes by
+    /// it); false when it stays the relaxed upper end of the rays.
+    const SHRINKS: bool = false;
     /// The lanes still looking for hits.
     fn active(&self) -> L::Mask;
     /// The upper end each lane's kernel test uses now (relaxed; see [`relax`]).
@@ -331,6 +332,8 @@ impl<L: Lane> Closest<L> {
 }
 
 impl<L: Lane> Collector<L> for Closest<L> {
+    const SHRINKS: bool = true;
+
     #[inline(always)]
     fn active(&self) -> L::Mask {
         self.valid

@@ -53,6 +53,9 @@
 #![deny(missing_docs)]
 #![forbid(unsafe_op_in_unsafe_fn)]
 
+#[cfg(feature = "alloc")]
+extern crate alloc;
+
 pub mod bounds;
 pub mod bvh;
 pub mod camera;

@@ -465,42 +465,50 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
         if K::UNIT_DIRECTIONS && (ray.dir().length_squared() - 1.0).abs() > UNIT_TOLERANCE {
             return false;
         }
-        let r4 = RayPacket::<f32x4>::splat(ray);
+        let r4 = RayPacket::<f32x4>::splat(ray).shrink(Mask::splat(true), f32x4::splat(c.t_max()));
         // The kernel's per-ray set-up (Watertight: the shear, 3 divisions), made at the first
         // leaf: most rays that leave a surface reach none.
         let mut pre = None;
-        traverse::one(self.nodes, self.reach, ray, c, |li, c| {
-            let Some(leaf) = self.leaves.get(li as usize) else {
-                return false;
-            };
-            let r = RayPacket {
-                t_max: f32x4::splat(c.t_max()),
-                ..r4
-            };
-            let pre = pre.get_or_insert_with(|| K::prepare(&r4));
-            let h = K::first(&r, pre, &leaf.four(), cull);
-            let mut bits = h.mask.bits();
-            while bits != 0 {
-                let j = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let one = LaneHit {
-                    t: h.t.lane(j),
-                    u: h.u.lane(j),
-                    v: h.v.lane(j),
-                    w: h.w.lane(j),
-                    mask: true,
+        traverse::one(
+            self.nodes,
+            self.reach,
+            ray,
+            c,
+            #[inline(always)]
+            |li, c| {
+                let Some(leaf) = self.leaves.get(li as usize) else {
+                    return false;
                 };
-                let at = At {
-                    set,
-                    index: leaf.indices()[j],
-                    loc: li * LEAF_WIDTH as u32 + j as u32,
+                let r = if C::SHRINKS {
+                    r4.shrink(Mask::splat(true), f32x4::splat(c.t_max()))
+                } else {
+                    r4
                 };
-                if c.offer(&one, at, |_| Hits::miss()) {
-                    return true;
+                let pre = pre.get_or_insert_with(|| K::prepare(&r4));
+                let h = K::first(&r, pre, &leaf.four(), cull);
+                let mut bits = h.mask.bits();
+                while bits != 0 {
+                    let j = bits.trailing_zeros() as usize;
+                    bits &= bits - 1;
+                    let one = LaneHit {
+                        t: h.t.lane(j),
+                        u: h.u.lane(j),
+                        v: h.v.lane(j),
+                        w: h.w.lane(j),
+                        mask: true,
+                    };
+                    let at = At {
+                        set,
+                        index: leaf.indices()[j],
+                        loc: li * LEAF_WIDTH as u32 + j as u32,
+                    };
+                    if c.offer(&one, at, |_| Hits::miss()) {
+                        return true;
+                    }
                 }
-            }
-            false
-        })
+                false
+            },
+        )
     }
 
     #[inline]
@@ -598,4 +606,106 @@ pub(crate) fn reach<N: Layout>(n: &N) -> f32 {
         }
     }
     r
+}
+
+/// A tree that owns its storage (feature `alloc`): one call builds it, as a game engine
+/// expects. It answers exactly as the [`Bvh`] over caller storage that [`view`](Self::view)
+/// gives (a [`Set`] like every other).
+///
+/// ```
+/// use raylane::bvh::OwnedBvh;
+/// use raylane::glam::Vec3;
+/// use raylane::triangle::Triangle;
+/// use raylane::{Query, Ray};
+///
+/// let tris = [Triangle::new(Vec3::ZERO, Vec3::X, Vec3::Y)];
+/// let tree = OwnedBvh::new(&tris[..]).unwrap();
+/// let hit = tree.closest(&Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::NEG_Z)).unwrap();
+/// assert_eq!((hit.t, hit.index), (1.0, 0));
+/// ```
+#[cfg(feature = "alloc")]
+#[derive(Clone, Debug)]
+pub struct OwnedBvh<P: Packed> {
+    nodes: alloc::vec::Vec<Node>,
+    leaves: alloc::vec::Vec<P>,
+    reach: f32,
+}
+
+#[cfg(feature = "alloc")]
+impl<P: Packed> OwnedBvh<P> {
+    /// Builds the tree over `prims` (a slice of triangles or spheres, a
+    /// [`Mesh`](crate::mesh::Mesh)), keeping only the storage the build used.
+    ///
+    /// # Errors
+    ///
+    /// [`BuildError::TooMany`] for more than [`MAX_PRIMITIVES`].
+    pub fn new<Q: Primitives<Leaf = P> + ?Sized>(prims: &Q) -> Result<Self, BuildError> {
+        use alloc::vec;
+        let need = sizes(prims.count());
+        let mut nodes = vec![Node::EMPTY; need.nodes];
+        let mut leaves = vec![P::EMPTY; need.leaves];
+        let mut scratch = vec![Scratch::default(); need.scratch];
+        let (n, l, reach) = {
+            let t = build::build(prims, &mut nodes, &mut leaves, &mut scratch)?;
+            (t.nodes.len(), t.leaves.len(), t.reach)
+        };
+        nodes.truncate(n);
+        leaves.truncate(l);
+        nodes.shrink_to_fit();
+        leaves.shrink_to_fit();
+        Ok(OwnedBvh {
+            nodes,
+            leaves,
+            reach,
+        })
+    }
+
+    /// The tree as a [`Bvh`] over this storage.
+    #[must_use]
+    pub fn view(&self) -> Bvh<'_, P> {
+        Bvh {
+            nodes: &self.nodes,
+            leaves: &self.leaves,
+            reach: self.reach,
+        }
+    }
+}
+
+#[cfg(feature = "alloc")]
+impl<P: Leaf> Set for OwnedBvh<P> {
+    type Prim = P::Prim;
+    type Kernel = P::Kernel;
+
+    #[inline]
+    fn trace_with<K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        self.view().trace_with::<K, L, C>(cull, rays, set, c)
+    }
+
+    #[inline]
+    fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
+        &self,
+        cull: Cull,
+        ray: &Ray,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        self.view().trace_ray_with::<K, C>(cull, ray, set, c)
+    }
+
+    #[inline]
+    fn records_with<L: Lane>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        w: &Winners<L>,
+    ) -> Hits<L> {
+        self.view().records_with(cull, rays, set, w)
+    }
 }

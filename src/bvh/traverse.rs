@@ -123,7 +123,7 @@ fn one_with<const S: usize, N: Layout, C: Collector<f32>>(
     let mut stack = Stack::<S>::new();
     stack.push_sorted(root, bits, &tn);
     while let Some((r, tn)) = stack.pop() {
-        if tn > c.t_max() {
+        if C::SHRINKS && tn > c.t_max() {
             continue;
         }
         if r & LEAF == 0 {
