@@ -47,6 +47,7 @@ use std::time::{Duration, Instant};
 
 use glam::Vec3;
 use raylane::Lane;
+use raylane::bvh::OwnedBvh;
 use raylane::plane::FocalPlane;
 use raylane::sphere::FocalSphere;
 use raylane::triangle::FocalTriangle;
@@ -537,11 +538,13 @@ fn traced(o: &Options, name: &str) -> Result<(&'static str, Picture, usize), Str
     };
     let made = made.elapsed();
     let tris = mesh.triangles();
-    let tree = bvh::Tree::new(&tris).map_err(|e| e.to_string())?;
+    let built = Instant::now();
+    let tree = OwnedBvh::new(&tris[..]).map_err(|e| e.to_string())?;
+    let built = built.elapsed();
     let (cam, centre, radius) = bvh::framing(&mesh, w, h);
     let light = centre + Vec3::new(-1.0, 2.0, 1.5).normalize() * (3.0 * radius);
     let eps = 1e-4 * radius;
-    let t = tree.bvh();
+    let t = tree.view();
     let shot = match o.lanes {
         1 => bvh::render::<f32>(&t, &tris, &cam, light, eps, o.threads),
         4 => bvh::render::<f32x4>(&t, &tris, &cam, light, eps, o.threads),
@@ -558,8 +561,8 @@ fn traced(o: &Options, name: &str) -> Result<(&'static str, Picture, usize), Str
             rate(shot.shadow),
             shot.shadow.0,
             tris.len(),
-            tree.build.as_secs_f64(),
-            tree.bytes() as f64 / tris.len().max(1) as f64,
+            built.as_secs_f64(),
+            t.stats().bytes as f64 / tris.len().max(1) as f64,
             if name == "million" {
                 format!(", subdivided in {:.2} s", made.as_secs_f64())
             } else {
@@ -659,7 +662,6 @@ fn mesh(o: &Options) -> (&'static str, Picture, usize) {
 /// The firmware `bvh`'s picture (`targets/src/bin/bvh.rs`): the vendored bunny's BVH built by
 /// `raylane_lab::demo::bunny`'s code on one thread, primary rays only.
 fn bunny_fw(o: &Options) -> (&'static str, Picture, usize) {
-    use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
     use raylane_lab::demo::bunny;
     let (w, h) = o.size.unwrap_or(bunny::SIZE);
     let start = Instant::now();
@@ -667,12 +669,8 @@ fn bunny_fw(o: &Options) -> (&'static str, Picture, usize) {
     let n = bunny::load(include_bytes!("../tests/data/bunny.bin"), &mut tris)
         .expect("tests/data/bunny.bin is well formed");
     tris.truncate(n);
-    let need = bvh::TriangleBvh::needed(n);
-    let mut nodes = vec![Node::EMPTY; need.nodes];
-    let mut leaves = vec![<Tri4 as Packed>::EMPTY; need.leaves];
-    let mut scratch = vec![Scratch::default(); need.scratch];
-    let tree = bvh::Bvh::build(&tris[..], &mut nodes[..], &mut leaves[..], &mut scratch[..])
-        .expect("storage sized by bvh::needed");
+    let owned = OwnedBvh::new(&tris[..]).expect("fewer than 2^30 triangles");
+    let tree = owned.view();
     let cam = bunny::camera(&tris, w, h);
     let mut rgb = vec![0u8; 3 * w as usize * h as usize];
     let hits = match o.lanes {

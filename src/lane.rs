@@ -189,8 +189,8 @@ pub trait Lane:
     /// The per-lane boolean.
     type Mask: Mask;
     /// A single `f64` lane used for rare higher-precision fallbacks of one lane
-    /// (`f64` itself, or `Counted<f64>` when counting).
-    #[doc(hidden)]
+    /// (`f64` itself, or `Counted<f64>` when counting): a lane whose f32 products would under-
+    /// or overflow is recomputed in it, so the fallback is counted like the rest of a kernel.
     type Precise: Lane<Scalar = f64>;
     /// One `u32` per lane, for primitive indices in hit records.
     type Indices: Copy + Debug + PartialEq + AsRef<[u32]> + AsMut<[u32]>;
@@ -227,7 +227,6 @@ pub trait Lane:
     /// Every index set to `v`.
     fn indices(v: u32) -> Self::Indices;
     /// Lane `i` as a single higher-precision lane (exact widening).
-    #[doc(hidden)]
     fn precise_lane(self, i: usize) -> Self::Precise;
 
     /// Builds a lane value from `f32` elements (exact).

@@ -7,15 +7,15 @@
 //!    `benches/src/subdivide.rs`), made here in about a second;
 //!
 //! and `--obj FILE` any Wavefront OBJ (loaded with `tobj`, a dev-dependency used only here).
-//! The tree is built on one thread into `Vec`s sized by [`bvh::needed`]; primary rays and
-//! shadow rays are timed as two separate passes, each on every core, and reported in Mrays/s.
+//! The tree is built on one thread ([`raylane::bvh::OwnedBvh`]); primary rays and shadow rays
+//! are timed as two separate passes, each on every core, and reported in Mrays/s.
 
 use std::path::Path;
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::time::{Duration, Instant};
 
 use glam::Vec3;
-use raylane::bvh::{self, Node, Scratch, Tri4, TriangleBvh};
+use raylane::bvh::TriangleBvh;
 use raylane::triangle::Triangle;
 use raylane::{Lane, Pinhole, Query, Ray, RayPacket};
 
@@ -86,46 +86,6 @@ impl MeshData {
                 _ => Triangle::never(),
             })
             .collect()
-    }
-}
-
-/// A tree over owned storage.
-pub struct Tree {
-    nodes: Vec<Node>,
-    leaves: Vec<Tri4>,
-    /// Build time.
-    pub build: Duration,
-}
-
-impl Tree {
-    /// Builds the tree over `tris`.
-    pub fn new(tris: &[Triangle]) -> Result<Self, bvh::BuildError> {
-        let start = Instant::now();
-        let need = bvh::TriangleBvh::needed(tris.len());
-        let mut nodes = vec![Node::EMPTY; need.nodes];
-        let mut leaves = vec![<Tri4 as bvh::Packed>::EMPTY; need.leaves];
-        let mut scratch = vec![Scratch::default(); need.scratch];
-        let (n, l) = {
-            let t = bvh::Bvh::build(tris, &mut nodes, &mut leaves, &mut scratch)?;
-            (t.nodes().len(), t.leaves().len())
-        };
-        nodes.truncate(n);
-        leaves.truncate(l);
-        Ok(Tree {
-            nodes,
-            leaves,
-            build: start.elapsed(),
-        })
-    }
-
-    /// The tree.
-    pub fn bvh(&self) -> TriangleBvh<'_> {
-        bvh::Bvh::from_parts(&self.nodes, &self.leaves).expect("a tree build() made")
-    }
-
-    /// Bytes of nodes and leaves.
-    pub fn bytes(&self) -> usize {
-        size_of_val(&self.nodes[..]) + size_of_val(&self.leaves[..])
     }
 }
 
