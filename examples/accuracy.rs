@@ -1,15 +1,17 @@
-//! Every method's accuracy against the exact answers, per class of input: the README's tables.
+//! Every method's accuracy against the exact answers, per class of input: the tables of
+//! `docs/accuracy.md`.
 //!
 //! ```text
-//! cargo run --release --features vectors --example accuracy [-- --lanes 1|4|8|16] [--write] [DIR]
+//! cargo run --release --example accuracy [-- --lanes 1|4|8|16] [--write] [DIR]
 //! ```
 //!
 //! Reads each class's vector file (`raylane_lab::vectors::accuracy::CLASSES`) from `DIR` (default
 //! `tests/vectors`), runs every method of its kind, and prints the Markdown tables: the largest
 //! relative `t` error and absolute `u`, `v` error against the exact answers, then the same over
 //! each case's recorded conditioning. `tests/suite/accuracy.rs` pins this output
-//! (`tests/suite/accuracy_pinned.md`, also the README's tables between its `accuracy` markers);
-//! after a change to a kernel, `--write` rewrites both (run from the repository root).
+//! (`tests/suite/accuracy_pinned.md`, also the tables between the `accuracy` markers of
+//! `docs/accuracy.md`); after a change to a kernel, `--write` rewrites both (run from the
+//! repository root).
 
 use std::process::ExitCode;
 
@@ -63,19 +65,19 @@ fn main() -> ExitCode {
             eprintln!("cannot write the pins: {e}");
             return ExitCode::FAILURE;
         }
-        eprintln!("wrote tests/suite/accuracy_pinned.md and the README's accuracy tables");
+        eprintln!("wrote tests/suite/accuracy_pinned.md and the tables of docs/accuracy.md");
     }
     ExitCode::SUCCESS
 }
 
-/// Writes the pinned tables and replaces the README's between its markers.
+/// Writes the pinned tables and replaces those of `docs/accuracy.md` between its markers.
 fn write_pins(report: &str) -> std::io::Result<()> {
     std::fs::write("tests/suite/accuracy_pinned.md", report)?;
-    let readme = std::fs::read_to_string("README.md")?;
+    let doc = std::fs::read_to_string("docs/accuracy.md")?;
     let (begin, end) = ("<!-- accuracy:begin -->\n", "<!-- accuracy:end -->");
-    let bad = || std::io::Error::other("README.md lacks the accuracy markers");
-    let start = readme.find(begin).ok_or_else(bad)? + begin.len();
-    let stop = start + readme[start..].find(end).ok_or_else(bad)?;
-    let new = format!("{}{report}{}", &readme[..start], &readme[stop..]);
-    std::fs::write("README.md", new)
+    let bad = || std::io::Error::other("docs/accuracy.md lacks the accuracy markers");
+    let start = doc.find(begin).ok_or_else(bad)? + begin.len();
+    let stop = start + doc[start..].find(end).ok_or_else(bad)?;
+    let new = format!("{}{report}{}", &doc[..start], &doc[stop..]);
+    std::fs::write("docs/accuracy.md", new)
 }

@@ -5,9 +5,9 @@
 //! bytes and precomputation per primitive, accuracy per input class, and watertightness.
 //!
 //! ```text
-//! cargo run --example opcount            # the two Markdown tables (the README's)
+//! cargo run --example opcount            # the two Markdown tables (docs/opcounts.md's)
 //! cargo run --example opcount -- --csv   # the report as kernel,path,mul,add,div,sqrt,cmp
-//! cargo run --example opcount -- --write # rewrites the README's study table (from the root)
+//! cargo run --example opcount -- --write # rewrites both tables of docs/opcounts.md (from root)
 //! opcount --measure                       # the study's timed loops (scripts/count-study.sh)
 //! ```
 //!
@@ -74,10 +74,31 @@ fn main() {
     let table = study::report();
     print!("\n{table}");
     if write {
-        let readme = std::fs::read_to_string("README.md").expect("run from the repository root");
-        let (start, stop) = study::readme_section(&readme);
-        let new = format!("{}{table}{}", &readme[..start], &readme[stop..]);
-        std::fs::write("README.md", new).expect("README.md is writable");
-        eprintln!("wrote the README's study table");
+        let doc = std::fs::read_to_string(DOC).expect("run from the repository root");
+        let doc = replace_between(&doc, OPCOUNT_BEGIN, OPCOUNT_END, &out);
+        let (start, stop) = study::doc_section(&doc);
+        let doc = format!("{}{table}{}", &doc[..start], &doc[stop..]);
+        std::fs::write(DOC, doc).expect("docs/opcounts.md is writable");
+        eprintln!("wrote the op-count and study tables of {DOC}");
     }
+}
+
+/// The page that holds both tables, between their markers.
+const DOC: &str = "docs/opcounts.md";
+/// The markers around the op-count report (pinned by `tests/suite/readme.rs`).
+const OPCOUNT_BEGIN: &str = "<!-- opcount:begin -->\n";
+/// The end marker.
+const OPCOUNT_END: &str = "<!-- opcount:end -->";
+
+/// `doc` with the text between `begin` and `end` replaced by `text`.
+fn replace_between(doc: &str, begin: &str, end: &str, text: &str) -> String {
+    let start = doc
+        .find(begin)
+        .unwrap_or_else(|| panic!("{DOC} lacks the marker {begin:?}"))
+        + begin.len();
+    let stop = doc[start..]
+        .find(end)
+        .unwrap_or_else(|| panic!("{DOC} lacks the marker {end:?}"))
+        + start;
+    format!("{}{text}{}", &doc[..start], &doc[stop..])
 }

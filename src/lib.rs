@@ -78,6 +78,11 @@ pub mod vec3;
 #[doc = include_str!("../README.md")]
 struct ReadmeDoctests;
 
+/// The design notes' examples, compiled and run as doctests.
+#[cfg(doctest)]
+#[doc = include_str!("../docs/design.md")]
+struct DesignDoctests;
+
 pub use camera::Pinhole;
 pub use hit::{Hit, Hits};
 pub use kernel::Cull;

@@ -6,8 +6,9 @@
 //! are deterministic and bit-identical at every lane width and on every target (the digests
 //! show it), so they are pinned exactly at their printed precision (two significant digits, or
 //! two decimals for ratios below 10): no slack beyond the printing. After a kernel change,
-//! `cargo run --release --features vectors --example accuracy -- --write` rewrites the pin
-//! (`tests/suite/accuracy_pinned.md`) and the README's tables between its `accuracy` markers.
+//! `cargo run --release --example accuracy -- --write` rewrites the pin
+//! (`tests/suite/accuracy_pinned.md`) and the tables between the `accuracy` markers of
+//! `docs/accuracy.md`.
 
 use raylane_lab::vectors::accuracy::{self, Class, Errors};
 use raylane_lab::vectors::{Case, Method, Outcome};
@@ -33,7 +34,7 @@ fn report(lanes: usize) -> String {
     s
 }
 
-/// The measured tables (`cargo run --release --features vectors --example accuracy`).
+/// The measured tables (`cargo run --release --example accuracy`).
 const PINNED: &str = include_str!("accuracy_pinned.md");
 
 #[test]
@@ -61,34 +62,34 @@ fn accuracy_is_pinned() {
     assert!(
         now == PINNED,
         "the measured accuracy changed; if that is intended, run `cargo run --release \
-         --features vectors --example accuracy -- --write` (it writes \
-         tests/suite/accuracy_pinned.md and the README's tables). The new tables:\n{now}"
+         --example accuracy -- --write` (it writes tests/suite/accuracy_pinned.md and the \
+         tables of docs/accuracy.md). The new tables:\n{now}"
     );
 }
 
 #[test]
-fn readme_accuracy_tables_are_the_report() {
-    let readme = include_str!("../../README.md");
+fn docs_accuracy_tables_are_the_report() {
+    let doc = include_str!("../../docs/accuracy.md");
     let begin = "<!-- accuracy:begin -->\n";
     let end = "<!-- accuracy:end -->";
-    let start = readme
+    let start = doc
         .find(begin)
-        .expect("README has the accuracy:begin marker")
+        .expect("docs/accuracy.md has the accuracy:begin marker")
         + begin.len();
-    let stop = readme[start..]
+    let stop = doc[start..]
         .find(end)
-        .expect("README has the accuracy:end marker")
+        .expect("docs/accuracy.md has the accuracy:end marker")
         + start;
     assert_eq!(
-        &readme[start..stop],
+        &doc[start..stop],
         PINNED,
-        "the README's accuracy tables differ from tests/suite/accuracy_pinned.md"
+        "the tables of docs/accuracy.md differ from tests/suite/accuracy_pinned.md"
     );
 }
 
-/// The README's kernel table: `robust`, the sphere `focal` and the plane are within their
-/// conditioning on every class; the textbook sphere forms are 10 to 1000× off somewhere and
-/// get hit/miss wrong on far spheres; `cramer` and `moller` lose `t` on needles.
+/// The kernel tables (README.md, docs/accuracy.md): `robust`, the sphere `focal` and the plane
+/// are within their conditioning on every class; the textbook sphere forms are 10 to 1000× off
+/// somewhere and get hit/miss wrong on far spheres; `cramer` and `moller` lose `t` on needles.
 #[test]
 fn kernel_table_claims_hold() {
     use raylane_lab::vectors::Kind;

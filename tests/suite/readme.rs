@@ -1,23 +1,24 @@
-//! The README's op-count table is the report's output (`cargo run --example opcount`).
+//! The op-count table of `docs/opcounts.md` is the report's output (`cargo run --example opcount`,
+//! `-- --write` rewrites it).
 
 #[test]
-fn readme_op_count_table_is_the_report() {
-    let readme = include_str!("../../README.md");
+fn docs_op_count_table_is_the_report() {
+    let doc = include_str!("../../docs/opcounts.md");
     let begin = "<!-- opcount:begin -->\n";
     let end = "<!-- opcount:end -->";
-    let start = readme
+    let start = doc
         .find(begin)
-        .expect("README has the opcount:begin marker")
+        .expect("docs/opcounts.md has the opcount:begin marker")
         + begin.len();
-    let stop = readme[start..]
+    let stop = doc[start..]
         .find(end)
-        .expect("README has the opcount:end marker")
+        .expect("docs/opcounts.md has the opcount:end marker")
         + start;
     let mut want = String::new();
     raylane_lab::opcount::write_report(&mut want, &raylane_lab::opcount::table(), false).unwrap();
     assert_eq!(
-        &readme[start..stop],
+        &doc[start..stop],
         want,
-        "regenerate the README table with `cargo run --example opcount`"
+        "regenerate the table in docs/opcounts.md with `cargo run --example opcount -- --write`"
     );
 }

@@ -2,7 +2,7 @@
 //! ([`raylane_lab::study::entries`]) with each method's accuracy per input class (from the vector
 //! files, by [`raylane_lab::vectors::accuracy`]) and its leaks and double hits on the closed meshes
 //! of the watertight harness. `examples/opcount.rs` includes this file to print the table;
-//! the test pins the README's copy.
+//! the test pins the copy in `docs/opcounts.md`.
 
 use raylane_lab::study::{self, Entry, Insns, Measured, Shape};
 use raylane_lab::vectors::accuracy::{self, CLASSES};
@@ -10,7 +10,7 @@ use raylane_lab::vectors::{Case, Kind, Method, Outcome};
 
 use crate::watertight;
 
-/// The README's markers around the table.
+/// The markers around the table in `docs/opcounts.md`.
 pub const BEGIN: &str = "<!-- opstudy:begin -->\n";
 /// The end marker.
 pub const END: &str = "<!-- opstudy:end -->";
@@ -96,27 +96,27 @@ pub fn report() -> String {
     table
 }
 
-/// The README's copy of the table.
-pub fn readme_section(readme: &str) -> (usize, usize) {
-    let start = readme
+/// Where the copy of the table lies in `doc` (the text of `docs/opcounts.md`).
+pub fn doc_section(doc: &str) -> (usize, usize) {
+    let start = doc
         .find(BEGIN)
-        .expect("README has the opstudy:begin marker")
+        .expect("docs/opcounts.md has the opstudy:begin marker")
         + BEGIN.len();
-    let stop = readme[start..]
+    let stop = doc[start..]
         .find(END)
-        .expect("README has the opstudy:end marker")
+        .expect("docs/opcounts.md has the opstudy:end marker")
         + start;
     (start, stop)
 }
 
 #[test]
-fn readme_study_table_is_the_report() {
-    let readme = include_str!("../../README.md");
-    let (start, stop) = readme_section(readme);
+fn docs_study_table_is_the_report() {
+    let doc = include_str!("../../docs/opcounts.md");
+    let (start, stop) = doc_section(doc);
     assert_eq!(
-        &readme[start..stop],
+        &doc[start..stop],
         report(),
-        "regenerate the README's study table with `cargo run --example opcount -- --write`"
+        "regenerate the study table of docs/opcounts.md: `cargo run --example opcount -- --write`"
     );
 }
 
