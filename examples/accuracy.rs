@@ -8,8 +8,8 @@
 //! Reads each class's vector file (`raylane_lab::vectors::accuracy::CLASSES`) from `DIR` (default
 //! `tests/vectors`), runs every method of its kind, and prints the Markdown tables: the largest
 //! relative `t` error and absolute `u`, `v` error against the exact answers, then the same over
-//! each case's recorded conditioning. `tests/suite/accuracy.rs` pins this output
-//! (`tests/suite/accuracy_pinned.md`, also the tables between the `accuracy` markers of
+//! each case's recorded conditioning. `tests/suite/kernels/accuracy_pinned.rs` pins this output
+//! (`tests/suite/kernels/accuracy_pinned.md`, also the tables between the `accuracy` markers of
 //! `docs/accuracy.md`); after a change to a kernel, `--write` rewrites both (run from the
 //! repository root).
 
@@ -65,14 +65,16 @@ fn main() -> ExitCode {
             eprintln!("cannot write the pins: {e}");
             return ExitCode::FAILURE;
         }
-        eprintln!("wrote tests/suite/accuracy_pinned.md and the tables of docs/accuracy.md");
+        eprintln!(
+            "wrote tests/suite/kernels/accuracy_pinned.md and the tables of docs/accuracy.md"
+        );
     }
     ExitCode::SUCCESS
 }
 
 /// Writes the pinned tables and replaces those of `docs/accuracy.md` between its markers.
 fn write_pins(report: &str) -> std::io::Result<()> {
-    std::fs::write("tests/suite/accuracy_pinned.md", report)?;
+    std::fs::write("tests/suite/kernels/accuracy_pinned.md", report)?;
     let doc = std::fs::read_to_string("docs/accuracy.md")?;
     let (begin, end) = ("<!-- accuracy:begin -->\n", "<!-- accuracy:end -->");
     let bad = || std::io::Error::other("docs/accuracy.md lacks the accuracy markers");

@@ -18,11 +18,11 @@
 // The study table's accuracy and watertightness come from the test suite's own harnesses,
 // included here so that the example and the pin test measure with the same code.
 #[allow(dead_code)]
-#[path = "../tests/suite/watertight.rs"]
-mod watertight;
+#[path = "../tests/suite/kernels/watertight_no_leaks.rs"]
+mod watertight_no_leaks;
 
 #[allow(dead_code)]
-#[path = "../tests/suite/study.rs"]
+#[path = "../tests/suite/kernels/op_count_study.rs"]
 mod study;
 
 /// Every study method on both paths (and its precomputation, if any), each one out-of-line
@@ -85,7 +85,7 @@ fn main() {
 
 /// The page that holds both tables, between their markers.
 const DOC: &str = "docs/opcounts.md";
-/// The markers around the op-count report (pinned by `tests/suite/readme.rs`).
+/// The markers around the op-count report (pinned by `tests/suite/docs/op_count_table.rs`).
 const OPCOUNT_BEGIN: &str = "<!-- opcount:begin -->\n";
 /// The end marker.
 const OPCOUNT_END: &str = "<!-- opcount:end -->";

@@ -68,13 +68,14 @@ fn offer_winners<L: Lane, C: Collector<L>>(c: &mut C, w: &Winners<L>, t: L, set:
     let mut left = w.mask;
     while left.any() {
         let j = left.bits().trailing_zeros() as usize;
-        let (index, loc) = (w.index.as_ref()[j], w.loc.as_ref()[j]);
+        let at_j = |x: &L::Indices| x.as_ref().get(j).copied().unwrap_or(u32::MAX);
+        let (index, loc) = (at_j(&w.index), at_j(&w.loc));
         let mut same = L::Mask::splat(false);
         let mut bits = left.bits();
         while bits != 0 {
             let k = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            if w.index.as_ref()[k] == index {
+            if w.index.as_ref().get(k) == Some(&index) {
                 same = same.with_lane(k, true);
             }
         }
@@ -369,9 +370,7 @@ impl Trace for FocalSpheres<'_> {
         }
         let other = rays.valid().and_not(at);
         other.any()
-            && flat::<Sphere, Robust, L, C>(rays, other, cull, set, c, self.spheres.len(), |i| {
-                self.spheres[i]
-            })
+            && flat::<Sphere, Robust, L, C>(rays, other, cull, set, c, self.spheres.iter().copied())
     }
 
     #[inline]
@@ -471,9 +470,14 @@ impl Trace for FocalPlanes<'_> {
         }
         let other = rays.valid().and_not(at);
         other.any()
-            && flat::<Plane, PlaneTest, L, C>(rays, other, cull, set, c, self.planes.len(), |i| {
-                self.planes[i]
-            })
+            && flat::<Plane, PlaneTest, L, C>(
+                rays,
+                other,
+                cull,
+                set,
+                c,
+                self.planes.iter().copied(),
+            )
     }
 
     #[inline]

@@ -346,33 +346,66 @@ impl<L: Lane> Collector<L> for Closest<L> {
 
     #[inline(always)]
     fn offer(&mut self, h: &LaneHit<L>, at: At, _: impl FnOnce(&Winners<L>) -> Hits<L>) -> bool {
+        if L::LANES == 1 {
+            self.consider(h, at);
+        } else {
+            self.consider_lanes(h, at);
+        }
+        false
+    }
+}
+
+impl<L: Lane> Closest<L> {
+    /// [`consider`](Self::consider) out of line: for packets, one copy per lane type rather
+    /// than one per kernel and set (the kernels dominate the work; the code is per kernel).
+    #[inline(never)]
+    fn consider_lanes(&mut self, h: &LaneHit<L>, at: At) {
+        self.consider(h, at);
+    }
+
+    /// The candidates of `h` from `at`: taken where they come first by `(t, set, index)`.
+    #[inline(always)]
+    fn consider(&mut self, h: &LaneHit<L>, at: At) {
         // The interval (the kernel checked t_min), then the tie rule.
         let inside = h.mask & h.t.lt(self.t_end);
         let mut take = inside & h.t.lt(self.t);
         let tie = inside & h.t.le(self.t) & h.t.ge(self.t);
         if tie.any() {
-            let mut bits = tie.bits();
-            while bits != 0 {
-                let j = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let (s, i) = (self.set.as_ref()[j], self.index.as_ref()[j]);
-                if (at.set, at.index) < (s, i) {
-                    take = take.with_lane(j, true);
-                }
-            }
+            take = take | self.wins_tie(tie, at);
         }
         if take.any() {
-            self.t = L::select(take, h.t, self.t);
-            self.u = L::select(take, h.u, self.u);
-            self.v = L::select(take, h.v, self.v);
-            self.w = L::select(take, h.w, self.w);
-            self.mask = self.mask | take;
-            select_indices::<L>(take, at.index, &mut self.index);
-            select_indices::<L>(take, at.set, &mut self.set);
-            select_indices::<L>(take, at.loc, &mut self.loc);
-            self.t_max = L::select(take, relax(h.t), self.t_max);
+            self.take(h, take, at);
         }
-        false
+    }
+
+    /// The lanes of `tie` (equal `t`) where `at` comes before the best so far.
+    #[inline(never)]
+    fn wins_tie(&self, tie: L::Mask, at: At) -> L::Mask {
+        let mut take = L::Mask::splat(false);
+        let mut bits = tie.bits();
+        while bits != 0 {
+            let j = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let get = |x: &L::Indices| x.as_ref().get(j).copied().unwrap_or(u32::MAX);
+            if (at.set, at.index) < (get(&self.set), get(&self.index)) {
+                take = take.with_lane(j, true);
+            }
+        }
+        take
+    }
+
+    /// Takes the hits of `h` (from `at`) in the lanes of `take`, and shrinks their `t_max`.
+    #[inline(always)]
+    fn take(&mut self, h: &LaneHit<L>, take: L::Mask, at: At) {
+        self.t = L::select(take, h.t, self.t);
+        self.u = L::select(take, h.u, self.u);
+        self.v = L::select(take, h.v, self.v);
+        self.w = L::select(take, h.w, self.w);
+        self.mask = self.mask | take;
+        self.t_max = L::select(take, relax(h.t), self.t_max);
+        select_indices::<L>(take, at.index, &mut self.index);
+        select_indices::<L>(take, at.set, &mut self.set);
+        select_indices::<L>(take, at.loc, &mut self.loc);
     }
 }
 

@@ -214,7 +214,14 @@ impl Set for Mesh<'_> {
     ) -> bool {
         let keep = self.kept(rays);
         keep.any()
-            && flat::<Triangle, K, L, C>(rays, keep, cull, set, c, self.len(), |i| self.prepared(i))
+            && flat::<Triangle, K, L, C>(
+                rays,
+                keep,
+                cull,
+                set,
+                c,
+                (0..self.len()).map(|i| self.prepared(i)),
+            )
     }
 
     #[inline]

@@ -243,18 +243,16 @@ pub(crate) fn only<L: Lane>(rays: &RayPacket<L>, keep: L::Mask) -> RayPacket<L> 
     }
 }
 
-/// The loop of every flat set: N rays × 1 primitive, primitives `0..n` in order, kernel `K`,
-/// the lanes of `keep` only (the others keep an empty interval). `prim(i)` is primitive `i`.
+/// The loop of every flat set: N rays × 1 primitive, `prims` in order (primitive `i` is the
+/// `i`-th), kernel `K`, the lanes of `keep` only (the others keep an empty interval).
 #[inline(always)]
-#[allow(clippy::too_many_arguments)]
 pub(crate) fn flat<P: Record, K: Kernel<P>, L: Lane, C: Collector<L>>(
     rays: &RayPacket<L>,
     keep: L::Mask,
     cull: Cull,
     set: u32,
     c: &mut C,
-    n: usize,
-    prim: impl Fn(usize) -> P,
+    prims: impl IntoIterator<Item = P>,
 ) -> bool {
     let rays = admit(rays, K::UNIT_DIRECTIONS);
     let keep = keep & rays.valid();
@@ -264,9 +262,8 @@ pub(crate) fn flat<P: Record, K: Kernel<P>, L: Lane, C: Collector<L>>(
     let pre = K::prepare(&rays);
     let mut r = only(&rays, keep);
     let neg = L::from_f32(f32::NEG_INFINITY);
-    for i in 0..n {
+    for (i, p) in prims.into_iter().enumerate() {
         r.t_max = L::select(keep, c.t_max(), neg);
-        let p = prim(i);
         let at = At {
             set,
             index: i as u32,
@@ -372,7 +369,7 @@ impl Set for [Sphere] {
         c: &mut C,
     ) -> bool {
         let all = Mask::splat(true);
-        flat::<Sphere, K, L, C>(rays, all, cull, set, c, self.len(), |i| self[i])
+        flat::<Sphere, K, L, C>(rays, all, cull, set, c, self.iter().copied())
     }
     #[inline]
     fn records_with<L: Lane>(
@@ -400,7 +397,7 @@ impl Set for [Triangle] {
         c: &mut C,
     ) -> bool {
         let all = Mask::splat(true);
-        flat::<Triangle, K, L, C>(rays, all, cull, set, c, self.len(), |i| self[i])
+        flat::<Triangle, K, L, C>(rays, all, cull, set, c, self.iter().copied())
     }
     #[inline]
     fn records_with<L: Lane>(
@@ -428,7 +425,7 @@ impl Set for [Plane] {
         c: &mut C,
     ) -> bool {
         let all = Mask::splat(true);
-        flat::<Plane, K, L, C>(rays, all, cull, set, c, self.len(), |i| self[i])
+        flat::<Plane, K, L, C>(rays, all, cull, set, c, self.iter().copied())
     }
     #[inline]
     fn records_with<L: Lane>(

@@ -42,7 +42,7 @@ impl<L: Lane<Scalar = f32>> LaneRecords for Winners<L> {
             t: self.t.lane(i),
             u: self.u.lane(i),
             v: self.v.lane(i),
-            index: self.index.as_ref()[i],
+            index: self.index.as_ref().get(i).copied().unwrap_or(u32::MAX),
         })
     }
 }
@@ -66,15 +66,16 @@ fn with<L: Lane>(rays: &RayPacket<L>, t_max: L) -> RayPacket<L> {
     rays.shrink(Mask::splat(true), t_max)
 }
 
-/// N rays × 1 primitive: `test(rays, i)` for `i` in `0..n`, the closest hit per lane.
-pub fn closest_with<L: Lane>(
+/// N rays × 1 primitive: `test(rays, p)` for the primitives `p` in order (primitive `i` the
+/// `i`-th), the closest hit per lane.
+pub fn closest_with<L: Lane, P>(
     rays: &RayPacket<L>,
-    n: usize,
-    mut test: impl FnMut(&RayPacket<L>, usize) -> LaneHit<L>,
+    prims: impl IntoIterator<Item = P>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
 ) -> Best<L> {
     let mut c = Closest::new(rays);
-    for i in 0..n {
-        let h = test(&with(rays, c.t_max()), i);
+    for (i, p) in prims.into_iter().enumerate() {
+        let h = test(&with(rays, c.t_max()), p);
         if h.mask.any() {
             c.offer(&h, at(i), none);
         }
@@ -83,14 +84,14 @@ pub fn closest_with<L: Lane>(
 }
 
 /// N rays × 1 primitive: the lanes that hit something inside their interval.
-pub fn any_with<L: Lane>(
+pub fn any_with<L: Lane, P>(
     rays: &RayPacket<L>,
-    n: usize,
-    mut test: impl FnMut(&RayPacket<L>, usize) -> LaneHit<L>,
+    prims: impl IntoIterator<Item = P>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
 ) -> L::Mask {
     let mut c = raylane::hit::Any::new(rays);
-    for i in 0..n {
-        let h = test(&with(rays, c.t_max()), i);
+    for (i, p) in prims.into_iter().enumerate() {
+        let h = test(&with(rays, c.t_max()), p);
         if h.mask.any() && c.offer(&h, at(i), none) {
             break;
         }
@@ -159,16 +160,12 @@ pub mod sphere {
 
     /// N rays × 1 sphere.
     pub fn closest<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, s: &[Sphere]) -> Best<L> {
-        closest_with(rays, s.len(), |r, i| {
-            K::roots(r, &SpherePacket::splat(&s[i])).first()
-        })
+        closest_with(rays, s, |r, x| K::roots(r, &SpherePacket::splat(x)).first())
     }
 
     /// N rays × 1 sphere: occlusion.
     pub fn any<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, s: &[Sphere]) -> L::Mask {
-        any_with(rays, s.len(), |r, i| {
-            K::roots(r, &SpherePacket::splat(&s[i])).first()
-        })
+        any_with(rays, s, |r, x| K::roots(r, &SpherePacket::splat(x)).first())
     }
 
     /// Every root of every sphere: `f(index, roots)` for each sphere some lane hits.
@@ -213,9 +210,7 @@ pub mod sphere {
             rays: &RayPacket<L>,
             cache: &[FocalSphere<f32>],
         ) -> Best<L> {
-            closest_with(rays, cache.len(), |r, i| {
-                K::roots(r, &Splat(&cache[i])).first()
-            })
+            closest_with(rays, cache, |r, e| K::roots(r, &Splat(e)).first())
         }
 
         /// N rays × 1 entry: occlusion.
@@ -223,9 +218,7 @@ pub mod sphere {
             rays: &RayPacket<L>,
             cache: &[FocalSphere<f32>],
         ) -> L::Mask {
-            any_with(rays, cache.len(), |r, i| {
-                K::roots(r, &Splat(&cache[i])).first()
-            })
+            any_with(rays, cache, |r, e| K::roots(r, &Splat(e)).first())
         }
 
         /// Every root of every entry some lane hits: `f(index, roots)`.
@@ -278,8 +271,8 @@ pub mod triangle {
         cull: Cull,
     ) -> Best<L> {
         let pre = K::prepare(rays);
-        closest_with(rays, t.len(), |r, i| {
-            K::intersect(r, &pre, &TrianglePacket::splat(&t[i]), cull)
+        closest_with(rays, t, |r, x| {
+            K::intersect(r, &pre, &TrianglePacket::splat(x), cull)
         })
     }
 
@@ -290,8 +283,8 @@ pub mod triangle {
         cull: Cull,
     ) -> L::Mask {
         let pre = K::prepare(rays);
-        any_with(rays, t.len(), |r, i| {
-            K::intersect(r, &pre, &TrianglePacket::splat(&t[i]), cull)
+        any_with(rays, t, |r, x| {
+            K::intersect(r, &pre, &TrianglePacket::splat(x), cull)
         })
     }
 
@@ -351,9 +344,7 @@ pub mod triangle {
             cull: Cull,
         ) -> Best<L> {
             let fr = FocalRays::new(rays);
-            let mut w = closest_with(fr.scaled(), cache.len(), |r, i| {
-                kernel(r, &Splat(&cache[i]), cull)
-            });
+            let mut w = closest_with(fr.scaled(), cache, |r, e| kernel(r, &Splat(e), cull));
             w.t = fr.own_units(w.t);
             w
         }
@@ -365,9 +356,7 @@ pub mod triangle {
             cull: Cull,
         ) -> L::Mask {
             let fr = FocalRays::new(rays);
-            any_with(fr.scaled(), cache.len(), |r, i| {
-                kernel(r, &Splat(&cache[i]), cull)
-            })
+            any_with(fr.scaled(), cache, |r, e| kernel(r, &Splat(e), cull))
         }
 
         /// Every hit: `f(index, hit)` (divided, `t` in the rays' own units).
@@ -428,16 +417,12 @@ pub mod plane {
 
     /// N rays × 1 plane.
     pub fn closest<L: Lane>(rays: &RayPacket<L>, p: &[Plane]) -> Best<L> {
-        closest_with(rays, p.len(), |r, i| {
-            intersect_lanes(r, &PlanePacket::splat(&p[i]))
-        })
+        closest_with(rays, p, |r, x| intersect_lanes(r, &PlanePacket::splat(x)))
     }
 
     /// N rays × 1 plane: occlusion.
     pub fn any<L: Lane>(rays: &RayPacket<L>, p: &[Plane]) -> L::Mask {
-        any_with(rays, p.len(), |r, i| {
-            intersect_lanes(r, &PlanePacket::splat(&p[i]))
-        })
+        any_with(rays, p, |r, x| intersect_lanes(r, &PlanePacket::splat(x)))
     }
 
     /// Every plane some lane hits: `f(index, hit)`.
@@ -452,7 +437,7 @@ pub mod plane {
 
     /// N rays from the eye × 1 cached plane.
     pub fn closest_focal<L: Lane>(rays: &RayPacket<L>, cache: &[FocalPlane]) -> Best<L> {
-        closest_with(rays, cache.len(), |r, i| cache[i].intersect_lanes(r))
+        closest_with(rays, cache, |r, e| e.intersect_lanes(r))
     }
 
     /// 1 ray × planes packed in lanes.

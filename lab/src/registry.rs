@@ -352,7 +352,7 @@ impl Kernel {
 // variant and name, whether it needs unit directions, its error model, and its call (family
 // and type). Adding a kernel is adding a row here. Each row's docs quote its pinned miss and
 // hit counts per lane (`opcount::table`, on the lectures' worked examples; the precomputed
-// methods precompute on the fly there) as `ops` markers, which `tests/suite/doc_counts.rs`
+// methods precompute on the fly there) as `ops` markers, which `tests/suite/docs/doc_op_counts.rs`
 // checks against the table.
 registry! {
     /// [`Quadratic`](raylane::sphere::Quadratic): the general quadratic.

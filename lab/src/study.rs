@@ -419,7 +419,7 @@ pub fn write_table(
     Ok(())
 }
 
-/// Every method of [`entries`], in its order: what [`repeat`] runs (`tests/suite/study.rs`
+/// Every method of [`entries`], in its order: what [`repeat`] runs (`tests/suite/kernels/op_count_study.rs`
 /// checks that the two lists agree).
 pub const METHODS: [(Shape, &str); 18] = [
     (Shape::Triangle, Cramer::NAME),

@@ -938,7 +938,7 @@ pub mod accuracy {
     //! f32: a method that returns it has error 0), and the same errors divided by each case's
     //! recorded conditioning (what a 2-ulp move of the inputs can change; 1 means "as wrong as
     //! the inputs' last two bits allow"). Cases whose hit/miss differs are counted, not measured.
-    //! [`write_report`] prints the Markdown tables of the README; `tests/suite/accuracy.rs`
+    //! [`write_report`] prints the Markdown tables of the README; `tests/suite/kernels/accuracy_pinned.rs`
     //! pins them and `cargo run --release --features vectors --example accuracy` prints them.
 
     use core::fmt;

@@ -499,7 +499,7 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
                     };
                     let at = At {
                         set,
-                        index: leaf.indices()[j],
+                        index: leaf.indices().get(j).copied().unwrap_or(EMPTY),
                         loc: li * LEAF_WIDTH as u32 + j as u32,
                     };
                     if c.offer(&one, at, |_| Hits::miss()) {

@@ -373,7 +373,8 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
             let Some(ray) = lane_ray(rays, j) else {
                 continue;
             };
-            let i = w.set.as_ref()[j] - set;
+            let get = |x: &L::Indices| x.as_ref().get(j).copied().unwrap_or(u32::MAX);
+            let i = get(&w.set).wrapping_sub(set);
             let Some((inst, object)) = self.placed(i) else {
                 continue;
             };
@@ -382,9 +383,9 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
                 t: lane(w.t, j),
                 u: lane(w.u, j),
                 v: lane(w.v, j),
-                index: [w.index.as_ref()[j]],
+                index: [get(&w.index)],
                 set: [0],
-                loc: [w.loc.as_ref()[j]],
+                loc: [get(&w.loc)],
                 mask: true,
             };
             let h = object

@@ -23,7 +23,7 @@ use crate::ray::RayPacket;
 ///
 /// **Claimed count.** None: `sphere_intersector.h` states none (read for this study).
 /// **Operation count per lane** (measured by `examples/opcount.rs`, the study table, pinned
-/// in `tests/suite/opcount.rs`; the
+/// in `tests/suite/kernels/op_counts_pinned.rs`; the
 /// per-ray reciprocal, 3 mul, 2 add, 1 div, counted in): miss 14 mul, 12 add, 1 div, 1 cmp;
 /// hit 15 mul, 15 add, 1 div, 1 sqrt, 5 cmp.
 ///

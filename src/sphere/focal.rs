@@ -42,7 +42,7 @@
 //! **Range.** The f32 path serves `c ≤ 10^18` and `r` within `10^-12…10^18`; every other
 //! sphere sends all its rays to the `f64` path (no ray is a certain miss there, even when `l²`
 //! overflows f32), so every finite input gets a correct answer: measured over positions
-//! scaled by `2^-140…2^140` (`tests/suite/robust.rs`), no root lost and none wrong.
+//! scaled by `2^-140…2^140` (`tests/suite/kernels/magnitude_regressions.rs`), no root lost and none wrong.
 //! [`FocalUnguarded`] answers only `c ≤ 2^30`, `r` within `2^-30…2^30` and never hits
 //! other spheres (a documented clean miss).
 //!

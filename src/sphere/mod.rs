@@ -36,7 +36,7 @@
 //! anyway: 5 compares, 3 for the unit-direction kernels, only on lanes that passed the miss
 //! test; a NaN or infinite discriminant also reaches the guard, by a free bit test). Other
 //! lanes are recomputed with [`Robust`] in `f64`, which holds every product of f32 inputs
-//! without over- or underflow, then rounded. **Measured** (`tests/suite/robust.rs`, 24 cases
+//! without over- or underflow, then rounded. **Measured** (`tests/suite/kernels/magnitude_regressions.rs`, 24 cases
 //! per kernel scaled by `2^k` in positions and radius and `2^j` in directions,
 //! `k, j ∈ −140…140`): inside `2^-29…2^29` every f32 answer equals the unit-scale answer times
 //! `2^(k−j)` bit for bit, so the accuracy measured at ordinary scale holds there; outside it

@@ -23,7 +23,7 @@ use crate::ray::RayPacket;
 ///
 /// **Claimed count.** None quoted: the study did not search the book's text for one.
 /// **Operation count per lane** (measured by `examples/opcount.rs`, the study table; pinned in
-/// `tests/suite/opcount.rs`): miss 21 mul, 17 add, 1 div, 1 sqrt, 1 cmp; hit 22 mul, 18 add,
+/// `tests/suite/kernels/op_counts_pinned.rs`): miss 21 mul, 17 add, 1 div, 1 sqrt, 1 cmp; hit 22 mul, 18 add,
 /// 3 div, 2 sqrt, 7 cmp.
 ///
 /// **Limits.** The decisions carry the rounding of `ℓ` (a few `2^-24·|f|`), like

@@ -29,7 +29,7 @@ use crate::vec3::V3;
 /// **Claimed count.** None found. The study searched the stored public pages and code for
 /// the Gem's own figures and reached only its citation and one-line summaries (e.g.
 /// Wikipedia's "a fast method"); its tally, if the Gem gives one, is not checked here.
-/// **Measured** per lane (pinned in `tests/suite/opcount.rs`): a triangle behind the origin
+/// **Measured** per lane (pinned in `tests/suite/kernels/op_counts_pinned.rs`): a triangle behind the origin
 /// (the plane rejects) 6 mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit 14 mul, 17
 /// add, 3 div, 6 cmp; precomputation 9 mul, 11 add, 3 cmp. **Record:** 42 bytes (the plane, 16;
 /// the two axes, 2 bytes as the Gem's `i1`, `i2`; six projected coordinates, 24).

@@ -40,7 +40,7 @@ use crate::vec3::V3;
 /// version of it except at very high ray-triangle hit rates", "at the expense of precomputing
 /// and storing a small amount of extra information for each triangle", and 1–6 % faster
 /// images in a complete ray tracer. Any operation count in the body is not checked here.
-/// **Measured** per lane (pinned in `tests/suite/opcount.rs`): a triangle behind the origin 6
+/// **Measured** per lane (pinned in `tests/suite/kernels/op_counts_pinned.rs`): a triangle behind the origin 6
 /// mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit 15 mul, 15 add, 1 div, 5 cmp;
 /// precomputation 22 mul, 15 add, 1 div, 3 cmp. **Record:** 48 bytes.
 ///

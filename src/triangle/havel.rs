@@ -31,7 +31,7 @@ use crate::vec3::V3;
 /// implemented on SSE4—outperforms the current state-of-the-art algorithms" and "allows both a
 /// single ray and ray packet intersection calculation with the same precomputed data". Any
 /// operation count in the paper's body is not checked here.
-/// **Measured** per lane (pinned in `tests/suite/opcount.rs`): miss 20 mul, 16 add, 5 cmp; hit
+/// **Measured** per lane (pinned in `tests/suite/kernels/op_counts_pinned.rs`): miss 20 mul, 16 add, 5 cmp; hit
 /// 21 mul, 16 add, 1 div, 12 cmp; behind the origin 20 mul, 16 add, 7 cmp; precomputation 36
 /// mul, 23 add, 1 div. **Record:** 48 bytes.
 ///

@@ -24,7 +24,7 @@ use crate::ray::RayPacket;
 /// the search's first fitness function "counts operations", the second benchmarks), not the
 /// counts of the test it arrived at. Embree's `triangle_intersector_moeller.h` claims its own
 /// Möller–Trumbore variant "is similar to the fastest one of the paper". Not checked here.
-/// **Measured** per lane (pinned in `tests/suite/opcount.rs`): miss 23 mul, 22 add, 1 div, 3
+/// **Measured** per lane (pinned in `tests/suite/kernels/op_counts_pinned.rs`): miss 23 mul, 22 add, 1 div, 3
 /// cmp; hit 27 mul, 24 add, 1 div, 5 cmp.
 ///
 /// **Limits.** Not watertight (`c` differs between triangles that share an edge), and the

@@ -33,7 +33,7 @@
 //! **Range.** The edge functions, `det` and `num_t` are products of two and three
 //! coordinates: for meshes of size `2^-40…2^30` they neither under- nor overflow, and
 //! [`Watertight`] is measured watertight there (both ends tested by
-//! `tests/suite/watertight_range.rs`; the accuracy tables are measured at ordinary scale).
+//! `tests/suite/kernels/watertight_range_ends.rs`; the accuracy tables are measured at ordinary scale).
 //! Outside that range the products round to zero, subnormals or infinity and rays may leak
 //! through edges or miss (a clean miss: `t = +inf`; the deferred-division kernels miss
 //! wherever `|det| < 2^-100`), but the answers stay consistent: each
@@ -41,7 +41,7 @@
 //! conservative at every magnitude (above), so N rays × 1 triangle and 1 ray × N triangles
 //! return the same closest hit bit for bit, every lane equals the scalar path, and every
 //! record is finite and strictly inside its interval. The seeded fuzzer
-//! (`tests/suite/fuzz.rs`: magnitudes `2^-140…2^127`, special values) checks this on every
+//! (`tests/suite/kernels/fuzz_every_width.rs`: magnitudes `2^-140…2^127`, special values) checks this on every
 //! case, its former failures kept as regression cases.
 //!
 //! **Asking.** Through [`Query`](crate::Query): `tris.closest(&ray)` (default kernel

@@ -36,11 +36,11 @@ use crate::ray::RayPacket;
 /// bits for both), although a ray through a shared edge or vertex may hit both. Around a
 /// shared vertex the products of the edges that meet there are rounded values near zero, and
 /// without the widening `ε` they can all exclude the ray: exact compares leaked 4 of the
-/// 10,950 rays of `tests/suite/watertight.rs`; with `ε` the counts are in the study table.
+/// 10,950 rays of `tests/suite/kernels/watertight_no_leaks.rs`; with `ε` the counts are in the study table.
 ///
 /// **Claimed count.** None found. Embree's source states none (read for this study); the
 /// study did not reach Segura and Feito's text (only its citation), so a tally there, if any,
-/// is not checked. **Measured** per lane (pinned in `tests/suite/opcount.rs`): miss 28 mul,
+/// is not checked. **Measured** per lane (pinned in `tests/suite/kernels/op_counts_pinned.rs`): miss 28 mul,
 /// 44 add, 6 cmp; hit 41 mul, 53 add, 1 div, 20 cmp.
 ///
 /// **Edge cases.** `den = 0` or `U + V + W = 0` is a miss; NaN fails every compare.

@@ -28,7 +28,7 @@ use crate::ray::RayPacket;
 /// **Claimed count.** None found. The study searched the stored public pages and code for the
 /// thesis' figures for this test and reached implementations of the `TriAccel` record, not
 /// the thesis' text; its tally, if any, is not checked here.
-/// **Measured** per lane (pinned in `tests/suite/opcount.rs`): a triangle behind the origin 5
+/// **Measured** per lane (pinned in `tests/suite/kernels/op_counts_pinned.rs`): a triangle behind the origin 5
 /// mul, 5 add, 1 div, 2 cmp; a miss beyond edge BC and a hit 11 mul, 12 add, 1 div, 5 cmp;
 /// precomputation 20 mul, 13 add, 1 div, 4 cmp. **Record:** 37 bytes (nine floats and the axis
 /// with the sign of `N_k` in one byte; the thesis pads its `TriAccel` to 48).

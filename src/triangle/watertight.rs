@@ -42,7 +42,7 @@ use crate::vec3::V3;
 ///
 /// **Range.** Watertight for meshes of size `2^-40…2^30` (`U`, `V`, `W` and `T` are products
 /// of two and three coordinates: beyond that range they under- or overflow and rays leak);
-/// tested at both ends by `tests/suite/watertight_range.rs`.
+/// tested at both ends by `tests/suite/kernels/watertight_range_ends.rs`.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Watertight;
 

@@ -20,7 +20,7 @@
 //! occur).
 //!
 //! The plot also shows, dashed, the fraction of rays whose exact answer could change under
-//! 2-ulp moves of the inputs (the band `tests/suite/focal_precision.rs` excludes): where a
+//! 2-ulp moves of the inputs (the band `tests/suite/kernels/focal_sphere_guard.rs` excludes): where a
 //! method's curve meets it, its errors are as large as the inputs' own rounding.
 
 use std::cmp::Ordering;
@@ -134,7 +134,7 @@ fn ulp(x: f32) -> f64 {
 }
 
 /// True when 2-ulp moves of the inputs could change the answer (first-order bound on
-/// `r² − l²`, as in `tests/suite/focal_precision.rs`).
+/// `r² − l²`, as in `tests/suite/kernels/focal_sphere_guard.rs`).
 fn in_band(eye: Vec3, dir: Vec3, c: Vec3, r: f32) -> bool {
     let e = [eye.x as f64, eye.y as f64, eye.z as f64];
     let u = [dir.x as f64, dir.y as f64, dir.z as f64];

@@ -3,7 +3,7 @@
 
 #[test]
 fn docs_op_count_table_is_the_report() {
-    let doc = include_str!("../../docs/opcounts.md");
+    let doc = include_str!("../../../docs/opcounts.md");
     let begin = "<!-- opcount:begin -->\n";
     let end = "<!-- opcount:end -->";
     let start = doc

@@ -4,7 +4,7 @@
 //! and bounding spheres are measured (tightness against the exact minimal sphere, hits never
 //! lost to culling, triangle tests saved).
 
-use crate::query::record;
+use crate::sets::query_records_every_width::record;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
@@ -419,8 +419,7 @@ where
         triangle::precompute_all::<K, L>(tris, &mut records),
         tris.len()
     );
-    let stored =
-        raylane_lab::loops::closest_with(&rp, records.len(), |r, i| K::test(r, &records[i], cull));
+    let stored = raylane_lab::loops::closest_with(&rp, &records, |r, rec| K::test(r, rec, cull));
     let fresh = internals::triangle::closest::<K, L>(&rp, tris, cull);
     for i in 0..rays.len() {
         assert_eq!(

@@ -21,7 +21,7 @@
 //! host, 300 on AArch64, whose CI run is under qemu-user); the seed is fixed (`RAYLANE_FUZZ_SEED`
 //! changes it), so a failure names its case and replays.
 
-use crate::query::record;
+use crate::sets::query_records_every_width::record;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};

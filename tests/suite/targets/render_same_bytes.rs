@@ -431,7 +431,7 @@ fn bunny_fw_render_is_pinned_at_every_width() {
     use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
     use raylane::triangle::Triangle;
     use raylane_lab::demo::bunny;
-    let bin = include_bytes!("../data/bunny.bin");
+    let bin = include_bytes!("../../data/bunny.bin");
     let mut tris = vec![Triangle::never(); bunny::TRIANGLES];
     assert_eq!(bunny::load(bin, &mut tris), Some(bunny::TRIANGLES));
     assert_eq!(bunny::load(&bin[..bin.len() - 1], &mut tris), None);

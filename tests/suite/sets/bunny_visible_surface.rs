@@ -34,8 +34,8 @@ use raylane_lab::loops::HitRecord;
 use raylane_lab::loops::LaneRecords;
 use wide::{f32x4, f32x8, f32x16};
 
-use crate::exact_ref::exact;
-use crate::query::record;
+use crate::kernels::exact_reference::exact;
+use crate::sets::query_records_every_width::record;
 use raylane::Query;
 
 /// Positions and index triples.
@@ -452,7 +452,7 @@ fn one_eye(
 
 #[test]
 fn bunny_closest_hit_is_the_visible_surface() {
-    let m = load_bin(include_bytes!("../data/bunny.bin"));
+    let m = load_bin(include_bytes!("../../data/bunny.bin"));
     assert_eq!((m.pos.len(), m.idx.len()), (1839, 3674));
     let (eyes, per_eye) = if cfg!(target_arch = "x86_64") {
         (50, 2000)

@@ -91,7 +91,10 @@ fn focal_all_entry_points(ray: &Ray, tris: &[Triangle], cull: Cull) -> Option<Hi
         let fr = RayPacket::<f32x8>::splat(ray);
         let h = fm.closest(&fr);
         for i in 0..8 {
-            same(crate::query::record(h.lane(i)), "FocalMesh::closest");
+            same(
+                crate::sets::query_records_every_width::record(h.lane(i)),
+                "FocalMesh::closest",
+            );
         }
         assert_eq!(fm.any(&fr).all(), want.is_some(), "FocalMesh::any");
         let mut n = 0;

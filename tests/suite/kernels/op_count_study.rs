@@ -8,7 +8,7 @@ use raylane_lab::study::{self, Entry, Insns, Measured, Shape};
 use raylane_lab::vectors::accuracy::{self, CLASSES};
 use raylane_lab::vectors::{Case, Kind, Method, Outcome};
 
-use crate::watertight;
+use super::watertight_no_leaks as watertight;
 
 /// The markers around the table in `docs/opcounts.md`.
 pub const BEGIN: &str = "<!-- opstudy:begin -->\n";
@@ -111,7 +111,7 @@ pub fn doc_section(doc: &str) -> (usize, usize) {
 
 #[test]
 fn docs_study_table_is_the_report() {
-    let doc = include_str!("../../docs/opcounts.md");
+    let doc = include_str!("../../../docs/opcounts.md");
     let (start, stop) = doc_section(doc);
     assert_eq!(
         &doc[start..stop],

@@ -7,14 +7,14 @@
 //! show it), so they are pinned exactly at their printed precision (two significant digits, or
 //! two decimals for ratios below 10): no slack beyond the printing. After a kernel change,
 //! `cargo run --release --example accuracy -- --write` rewrites the pin
-//! (`tests/suite/accuracy_pinned.md`) and the tables between the `accuracy` markers of
+//! (`tests/suite/kernels/accuracy_pinned.md`) and the tables between the `accuracy` markers of
 //! `docs/accuracy.md`.
 
 use raylane_lab::vectors::accuracy::{self, Class, Errors};
 use raylane_lab::vectors::{Case, Method, Outcome};
 
 fn text(c: &Class) -> &'static str {
-    crate::vectors::FILES
+    crate::kernels::vectors_every_width::FILES
         .iter()
         .find(|f| f.0 == c.file)
         .unwrap_or_else(|| panic!("no file for class {}", c.file))
@@ -62,14 +62,14 @@ fn accuracy_is_pinned() {
     assert!(
         now == PINNED,
         "the measured accuracy changed; if that is intended, run `cargo run --release \
-         --example accuracy -- --write` (it writes tests/suite/accuracy_pinned.md and the \
+         --example accuracy -- --write` (it writes tests/suite/kernels/accuracy_pinned.md and the \
          tables of docs/accuracy.md). The new tables:\n{now}"
     );
 }
 
 #[test]
 fn docs_accuracy_tables_are_the_report() {
-    let doc = include_str!("../../docs/accuracy.md");
+    let doc = include_str!("../../../docs/accuracy.md");
     let begin = "<!-- accuracy:begin -->\n";
     let end = "<!-- accuracy:end -->";
     let start = doc
@@ -83,7 +83,7 @@ fn docs_accuracy_tables_are_the_report() {
     assert_eq!(
         &doc[start..stop],
         PINNED,
-        "the tables of docs/accuracy.md differ from tests/suite/accuracy_pinned.md"
+        "the tables of docs/accuracy.md differ from tests/suite/kernels/accuracy_pinned.md"
     );
 }
 

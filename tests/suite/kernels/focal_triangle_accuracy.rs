@@ -20,7 +20,7 @@ use raylane::Ray;
 use raylane::triangle::{FocalTriangle, Moller, Triangle, Watertight};
 use raylane_lab::loops as internals;
 
-use crate::exact_ref::{Exact, exact};
+use crate::kernels::exact_reference::{Exact, exact};
 
 fn unit(rng: &mut SmallRng) -> Vec3 {
     loop {

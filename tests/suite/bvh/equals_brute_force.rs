@@ -8,7 +8,7 @@
 //! and bad input (NaN/inf and coincident vertices, empty and one-triangle meshes, a thousand
 //! copies of one triangle, all primitives at one point, coordinates near `1e30`).
 
-use crate::query::bits;
+use crate::sets::query_records_every_width::bits;
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
@@ -178,7 +178,7 @@ fn random_sphere_sets_equal_brute_force() {
 
 #[test]
 fn vendored_bunny_equals_brute_force() {
-    let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
+    let m = crate::sets::bunny_visible_surface::load_bin(include_bytes!("../../data/bunny.bin"));
     let mesh = Mesh::new(&m.pos, &m.idx);
     let (nodes, leaves) = owned(&mesh);
     let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
@@ -208,11 +208,14 @@ fn vendored_bunny_equals_brute_force() {
 /// force's, so the tree leaks exactly when Watertight does: never (0 leaks, asserted).
 #[test]
 fn watertight_sets_no_leaks_through_the_tree() {
-    for (si, s) in crate::watertight::shapes().iter().enumerate() {
+    for (si, s) in crate::kernels::watertight_no_leaks::shapes()
+        .iter()
+        .enumerate()
+    {
         let mesh = Mesh::new(&s.pos, &s.idx);
         let (nodes, leaves) = owned(&mesh);
         let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
-        let cases = crate::watertight::cases(s, 7 + si as u64);
+        let cases = crate::kernels::watertight_no_leaks::cases(s, 7 + si as u64);
         let tris = flat(&mesh);
         let mut leaks = 0;
         for c in &cases {
@@ -439,7 +442,7 @@ fn builds_are_deterministic() {
 
 #[test]
 fn refit_after_moving_vertices() {
-    let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
+    let m = crate::sets::bunny_visible_surface::load_bin(include_bytes!("../../data/bunny.bin"));
     let mut pos = m.pos.clone();
     let need = bvh::TriangleBvh::needed(m.idx.len());
     let mut nodes = vec![Node::EMPTY; need.nodes];
@@ -565,7 +568,7 @@ fn transform(rng: &mut SmallRng, scale: f32, mirror: bool) -> [[f32; 4]; 3] {
 fn instanced_scenes_equal_instance_by_instance() {
     use raylane::bvh::{Inst4, Instance, Scene};
     let mut rng = SmallRng::seed_from_u64(24);
-    let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
+    let m = crate::sets::bunny_visible_surface::load_bin(include_bytes!("../../data/bunny.bin"));
     let bunny = flat(&Mesh::new(&m.pos, &m.idx));
     let soup = soup(&mut rng, 300);
     let (n0, l0) = owned(&bunny[..]);

@@ -7,65 +7,77 @@ use raylane_lab::vectors::{self, Case, Digest, Kind, Method, Outcome, Verdict};
 pub(crate) const FILES: &[(&str, &str)] = &[
     (
         "sphere_lecture",
-        include_str!("../vectors/sphere_lecture.txt"),
+        include_str!("../../vectors/sphere_lecture.txt"),
     ),
     (
         "sphere_random",
-        include_str!("../vectors/sphere_random.txt"),
+        include_str!("../../vectors/sphere_random.txt"),
     ),
-    ("sphere_far", include_str!("../vectors/sphere_far.txt")),
+    ("sphere_far", include_str!("../../vectors/sphere_far.txt")),
     (
         "sphere_ground",
-        include_str!("../vectors/sphere_ground.txt"),
+        include_str!("../../vectors/sphere_ground.txt"),
     ),
     (
         "sphere_special",
-        include_str!("../vectors/sphere_special.txt"),
+        include_str!("../../vectors/sphere_special.txt"),
     ),
-    ("sphere_bad", include_str!("../vectors/sphere_bad.txt")),
-    ("plane_random", include_str!("../vectors/plane_random.txt")),
-    ("plane_bad", include_str!("../vectors/plane_bad.txt")),
+    ("sphere_bad", include_str!("../../vectors/sphere_bad.txt")),
+    (
+        "plane_random",
+        include_str!("../../vectors/plane_random.txt"),
+    ),
+    ("plane_bad", include_str!("../../vectors/plane_bad.txt")),
     (
         "triangle_random",
-        include_str!("../vectors/triangle_random.txt"),
+        include_str!("../../vectors/triangle_random.txt"),
     ),
     (
         "triangle_special",
-        include_str!("../vectors/triangle_special.txt"),
+        include_str!("../../vectors/triangle_special.txt"),
     ),
-    ("triangle_bad", include_str!("../vectors/triangle_bad.txt")),
-    ("triangle_far", include_str!("../vectors/triangle_far.txt")),
+    (
+        "triangle_bad",
+        include_str!("../../vectors/triangle_bad.txt"),
+    ),
+    (
+        "triangle_far",
+        include_str!("../../vectors/triangle_far.txt"),
+    ),
     (
         "triangle_needle",
-        include_str!("../vectors/triangle_needle.txt"),
+        include_str!("../../vectors/triangle_needle.txt"),
     ),
     (
         "triangle_grazing",
-        include_str!("../vectors/triangle_grazing.txt"),
+        include_str!("../../vectors/triangle_grazing.txt"),
     ),
     (
         "triangle_offset",
-        include_str!("../vectors/triangle_offset.txt"),
+        include_str!("../../vectors/triangle_offset.txt"),
     ),
     (
         "triangle_grid",
-        include_str!("../vectors/triangle_grid.txt"),
+        include_str!("../../vectors/triangle_grid.txt"),
     ),
     (
         "sphere_grazing",
-        include_str!("../vectors/sphere_grazing.txt"),
+        include_str!("../../vectors/sphere_grazing.txt"),
     ),
     (
         "sphere_offset",
-        include_str!("../vectors/sphere_offset.txt"),
+        include_str!("../../vectors/sphere_offset.txt"),
     ),
-    ("sphere_tiny", include_str!("../vectors/sphere_tiny.txt")),
-    ("sphere_huge", include_str!("../vectors/sphere_huge.txt")),
+    ("sphere_tiny", include_str!("../../vectors/sphere_tiny.txt")),
+    ("sphere_huge", include_str!("../../vectors/sphere_huge.txt")),
     (
         "plane_grazing",
-        include_str!("../vectors/plane_grazing.txt"),
+        include_str!("../../vectors/plane_grazing.txt"),
     ),
-    ("plane_offset", include_str!("../vectors/plane_offset.txt")),
+    (
+        "plane_offset",
+        include_str!("../../vectors/plane_offset.txt"),
+    ),
 ];
 
 fn load(text: &str) -> Vec<Case> {

@@ -11,8 +11,8 @@ use raylane::triangle::Triangle;
 use raylane::{Hit, Lane, Mask, Query, Ray, RayPacket};
 use wide::{f32x4, f32x8, f32x16};
 
-use crate::bvh::owned;
-use crate::query::bits;
+use crate::bvh::equals_brute_force::owned;
+use crate::sets::query_records_every_width::bits;
 
 /// The closest hit of `r` through `q` at every width (one ray, packets of 1, 4, 8, 16 with `r`
 /// in every lane), all required equal; and `any`, `all` required to agree with it.
@@ -111,9 +111,9 @@ fn ties_at_t_zero_go_to_the_lowest_index_in_every_set_and_width() {
 
 #[test]
 fn rays_from_shared_vertices_of_a_real_mesh_agree_with_brute_force() {
-    let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
+    let m = crate::sets::bunny_visible_surface::load_bin(include_bytes!("../../data/bunny.bin"));
     let mesh = Mesh::new(&m.pos, &m.idx);
-    let tris = crate::bvh::flat(&mesh);
+    let tris = crate::bvh::equals_brute_force::flat(&mesh);
     let (nodes, leaves) = owned(&mesh);
     let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
     let mut hits = 0;
@@ -133,9 +133,9 @@ fn rays_from_shared_vertices_of_a_real_mesh_agree_with_brute_force() {
 
 #[test]
 fn any_all_and_closest_agree_at_every_t_max() {
-    let m = crate::bunny::load_bin(include_bytes!("../data/bunny.bin"));
+    let m = crate::sets::bunny_visible_surface::load_bin(include_bytes!("../../data/bunny.bin"));
     let mesh = Mesh::new(&m.pos, &m.idx);
-    let tris = crate::bvh::flat(&mesh);
+    let tris = crate::bvh::equals_brute_force::flat(&mesh);
     let (nodes, leaves) = owned(&mesh);
     let tree = Bvh::from_parts(&nodes, &leaves).unwrap();
     let c = m.pos.iter().fold(Vec3::ZERO, |a, &p| a + p) / m.pos.len() as f32;

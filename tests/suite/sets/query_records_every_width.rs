@@ -19,7 +19,7 @@ use raylane_lab::loops as internals;
 use raylane_lab::loops::LaneRecords;
 use wide::{f32x4, f32x8, f32x16};
 
-use crate::bunny::load_bin;
+use crate::sets::bunny_visible_surface::load_bin;
 
 fn coord(rng: &mut SmallRng, scale: f32) -> f32 {
     match rng.random_range(0..200) {
@@ -200,7 +200,7 @@ fn sphere_queries_every_lane_equals_one_ray() {
 
 #[test]
 fn triangle_queries_every_lane_equals_one_ray() {
-    let m = load_bin(include_bytes!("../data/bunny.bin"));
+    let m = load_bin(include_bytes!("../../data/bunny.bin"));
     let tris: Vec<Triangle> = m
         .idx
         .iter()
@@ -288,7 +288,7 @@ fn mesh_and_focal_mesh_queries_every_lane_equals_one_ray() {
     use raylane::mesh::Mesh;
     use raylane::set::TooSmall;
     use raylane::triangle::FocalTriangle;
-    let m = load_bin(include_bytes!("../data/bunny.bin"));
+    let m = load_bin(include_bytes!("../../data/bunny.bin"));
     // Two invalid triangles (an index out of range, a zero-area one): listed once, never hit.
     let mut idx = m.idx.clone();
     idx.push([0, 0, 1]);
