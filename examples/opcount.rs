@@ -25,29 +25,27 @@ mod watertight_no_leaks;
 #[path = "../tests/suite/kernels/op_count_study.rs"]
 mod study;
 
-/// Every study method on both paths (and its precomputation, if any), each one out-of-line
-/// call of `raylane_lab::study::repeat` over 64 iterations and one over none, in 8 lanes, each
-/// call announced by a `cfg SHAPE METHOD PATH UNITS N` line (`UNITS` tests or builds per
-/// iteration; under callgrind, dump k is call k).
+/// Every study method (`raylane_lab::study::KERNELS`, in the registry's order) on both paths
+/// (and its precomputation, if any), each one out-of-line call of `raylane_lab::study::repeat`
+/// over 64 iterations and one over none, in 8 lanes, each call announced by a
+/// `cfg SHAPE METHOD PATH UNITS N` line (`UNITS` tests or builds per iteration; under
+/// callgrind, dump k is call k).
 fn measure() {
-    use raylane_lab::study::{self, METHODS, PATHS, Path, Shape};
+    use raylane_lab::study::{self, KERNELS, PATHS, Path};
     use std::io::Write;
     let mut out = std::io::stdout().lock();
-    for (i, (shape, method)) in METHODS.iter().enumerate() {
-        let shape = match shape {
-            Shape::Triangle => "triangle",
-            Shape::Sphere => "sphere",
-        };
+    for k in KERNELS {
+        let (shape, method) = (k.prim().name(), k.method().name());
         for (path, name) in PATHS {
-            if path == Path::Precompute && !study::precomputes(i) {
+            if path == Path::Precompute && !study::precomputes(k) {
                 continue;
             }
-            let units = study::units::<wide::f32x8>(i, path);
+            let units = study::units::<wide::f32x8>(k, path);
             for n in [64, 0] {
                 writeln!(out, "cfg {shape} {method} {name} {units} {n}").expect("stdout");
                 out.flush().expect("stdout");
                 let done = study::repeat::<wide::f32x8>(
-                    std::hint::black_box(i),
+                    std::hint::black_box(k),
                     std::hint::black_box(path),
                     std::hint::black_box(n),
                 );

@@ -1,13 +1,13 @@
 #!/usr/bin/env bash
 # Executed instructions per ray–primitive test of every method of the op-count study
-# (raylane::study, the README's study table), on x86-64-v3 (valgrind's callgrind, 8 lanes) and
-# on a Cortex-M4F (QEMU's mps2-an386 with the TCG plugin targets/plugin/insncount.c, scalar
-# lane). From scratch on Debian bookworm:
+# (raylane_lab::study, the study table of docs/opcounts.md), on x86-64-v3 (valgrind's callgrind,
+# 8 lanes) and on a Cortex-M4F (QEMU's mps2-an386 with the TCG plugin targets/plugin/insncount.c,
+# scalar lane). From scratch on Debian bookworm:
 #
 #   ./scripts/count-study.sh     rewrites docs/study-insns.txt (the counts `cargo run --example
 #                                opcount` prints; `-- --write` then puts them in the README)
 #
-# Both sides run the same timed loop, raylane::study::repeat (see its docs): per method and
+# Both sides run the same timed loop, raylane_lab::study::repeat (see its docs): per method and
 # path (miss, hit) one call over 64 tests and one over none; (count over 64 − count over none)
 # / (64 · lanes) is one test's instructions, the loop's bookkeeping included and the per-ray
 # setup and precomputation excluded. Counts are exact and repeatable for a given compiler:
@@ -30,14 +30,14 @@ fi
 rustup target add thumbv7em-none-eabihf 2>&1 | grep -v "is up to date" || true
 
 # x86-64-v3 (valgrind cannot decode AVX-512): the opcount example's --measure mode, one
-# callgrind dump per call of raylane::study::repeat.
+# callgrind dump per call of raylane_lab::study::repeat.
 RUSTFLAGS="-C target-cpu=x86-64-v3" cargo build --quiet --release --example opcount \
   --target-dir "$root/target/count-x86-64-v3"
 bin="$root/target/count-x86-64-v3/release/examples/opcount"
 dir=$(mktemp -d "$out/study.XXXXXX")
 trap 'rm -rf "$dir"' EXIT
 valgrind --tool=callgrind --collect-atstart=no \
-  --toggle-collect='raylane::study::repeat' --dump-after='raylane::study::repeat' \
+  --toggle-collect='raylane_lab::study::repeat' --dump-after='raylane_lab::study::repeat' \
   --callgrind-out-file="$dir/cg.out" "$bin" --measure > "$dir/manifest.txt" 2> "$dir/valgrind.log" \
   || { cat "$dir/valgrind.log" >&2; exit 1; }
 calls=$(grep -c '^cfg' "$dir/manifest.txt")
@@ -68,6 +68,8 @@ paste -d' ' <(grep '^cfg' "$dir/m4f.stdout") <(awk '$1 == "window" { print $3 }'
   > "$out/study-cortex-m4f.txt"
 
 # `cfg SHAPE METHOD PATH LANES TESTS INSNS`, the call over 64 tests before the one over none.
+# Keyed by shape, method and path (the order is the study's, raylane_lab::study::KERNELS, the
+# registry's); the report reads docs/study-insns.txt by those names, in any order.
 per_test() {
   awk -v target="$1" '
     $6 > 0 { key = $2 " " $3 " " $4; full[key] = $7; tests[key] = $6 * $5; order[++n] = key }

@@ -11,7 +11,8 @@
 //!   test or one of
 //!   the focal caches of planes and triangles. It carries its name (as the op-count report
 //!   spells it), what it intersects ([`Prim`]), whether it needs unit directions, and the
-//!   error model its documented limits follow ([`ErrorModel`]).
+//!   error model its documented limits follow ([`ErrorModel`]), and its source (the paper or
+//!   lecture, short: [`Kernel::source`]).
 //! * A [`Method`] is a name under which the checker runs kernels over the test vectors: one
 //!   kernel per primitive it tests. Every method has one kernel except `focal`, whose sphere,
 //!   plane and triangle caches run under one name (one digest per lane width).
@@ -200,7 +201,7 @@ macro_rules! registry {
             $(
                 $(#[doc = $kdoc:literal])*
                 $kernel:ident $kname:literal, unit: $unit:literal, error: $err:ident,
-                    $fam:ident $(($($arg:tt)*))?;
+                    source: $src:literal, $fam:ident $(($($arg:tt)*))?;
             )+
         }
     )+) => {
@@ -248,6 +249,15 @@ macro_rules! registry {
             pub const fn name(self) -> &'static str {
                 match self {
                     $( $( Kernel::$kernel => $kname, )+ )+
+                }
+            }
+
+            /// Where the test comes from, short (the paper, the lecture or raylane), as the
+            /// op-count study's table ([`study`](crate::study)) prints it.
+            #[must_use]
+            pub const fn source(self) -> &'static str {
+                match self {
+                    $( $( Kernel::$kernel => $src, )+ )+
                 }
             }
 
@@ -349,11 +359,12 @@ impl Kernel {
 }
 
 // The table: one row per kernel, grouped by the checker's method. Columns: the kernel's enum
-// variant and name, whether it needs unit directions, its error model, and its call (family
-// and type). Adding a kernel is adding a row here. Each row's docs quote its pinned miss and
-// hit counts per lane (`opcount::table`, on the lectures' worked examples; the precomputed
-// methods precompute on the fly there) as `ops` markers, which `tests/suite/docs/doc_op_counts.rs`
-// checks against the table.
+// variant and name, whether it needs unit directions, its error model, its source (short, as
+// the study's table prints it: `focal-unguarded`'s "the same" is the guarded `focal`, the row
+// above it there) and its call (family and type). Adding a kernel is adding a row here. Each
+// row's docs quote its pinned miss and hit counts per lane (`opcount::table`, on the lectures'
+// worked examples; the precomputed methods precompute on the fly there) as `ops` markers,
+// which `tests/suite/docs/doc_op_counts.rs` checks against the table.
 registry! {
     /// [`Quadratic`](raylane::sphere::Quadratic): the general quadratic.
     Quadratic "quadratic" {
@@ -361,7 +372,8 @@ registry! {
         ///
         /// Per lane: `ops quadratic/miss: 12 mul, 11 add, 1 cmp`;
         /// `ops quadratic/hit: 12 mul, 13 add, 2 div, 1 sqrt, 10 cmp`.
-        Quadratic "quadratic", unit: false, error: Textbook, sphere(raylane::sphere::Quadratic);
+        Quadratic "quadratic", unit: false, error: Textbook,
+            source: "the quadratic (lecture 004)", sphere(raylane::sphere::Quadratic);
     }
     /// [`QuadraticUnit`](raylane::sphere::QuadraticUnit): the quadratic with `a = 1`.
     QuadraticUnit "quadratic-unit" {
@@ -370,7 +382,7 @@ registry! {
         /// Per lane: `ops quadratic-unit/miss: 8 mul, 9 add, 1 cmp`;
         /// `ops quadratic-unit/hit: 8 mul, 11 add, 1 sqrt, 8 cmp`.
         QuadraticUnit "quadratic-unit", unit: true, error: Textbook,
-            sphere(raylane::sphere::QuadraticUnit);
+            source: "lecture 000, unit d", sphere(raylane::sphere::QuadraticUnit);
     }
     /// [`Geometric`](raylane::sphere::Geometric): the lecture's geometric test.
     Geometric "geometric" {
@@ -378,7 +390,8 @@ registry! {
         ///
         /// Per lane: `ops geometric/miss: 8 mul, 8 add, 1 cmp`;
         /// `ops geometric/hit: 8 mul, 11 add, 1 sqrt, 8 cmp`.
-        Geometric "geometric", unit: true, error: Textbook, sphere(raylane::sphere::Geometric);
+        Geometric "geometric", unit: true, error: Textbook,
+            source: "Glassner's geometric test, unit d", sphere(raylane::sphere::Geometric);
     }
     /// [`Robust`](raylane::sphere::Robust): Ray Tracing Gems ch. 7.
     Robust "robust" {
@@ -386,7 +399,8 @@ registry! {
         ///
         /// Per lane: `ops robust/miss: 14 mul, 13 add, 1 div, 1 cmp`;
         /// `ops robust/hit: 17 mul, 17 add, 3 div, 1 sqrt, 12 cmp`.
-        Robust "robust", unit: false, error: RobustSphere, sphere(raylane::sphere::Robust);
+        Robust "robust", unit: false, error: RobustSphere,
+            source: "Ray Tracing Gems ch. 7", sphere(raylane::sphere::Robust);
     }
     /// The focal caches of spheres (guarded), planes and triangles; per vector case the eye is
     /// the ray origin.
@@ -396,17 +410,20 @@ registry! {
         /// Per lane: `ops focal/miss: 4 mul, 2 add, 1 cmp`;
         /// `ops focal/hit: 10 mul, 10 add, 1 sqrt, 9 cmp`.
         Focal "focal", unit: true, error: Exact,
+            source: "raylane: rays from one eye, unit d",
             focal_sphere(raylane::sphere::focal::Focal, true);
         /// [`FocalPlane`](raylane::plane::FocalPlane) caches.
         ///
         /// Per lane: `ops plane-focal/miss: 3 mul, 2 add, 1 div, 2 cmp`;
         /// `ops plane-focal/hit: 3 mul, 2 add, 1 div, 2 cmp`.
-        PlaneFocal "plane-focal", unit: false, error: Exact, focal_plane;
+        PlaneFocal "plane-focal", unit: false, error: Exact,
+            source: "raylane: rays from one eye", focal_plane;
         /// [`FocalTriangle`](raylane::triangle::FocalTriangle) caches.
         ///
         /// Per lane: `ops triangle-focal/miss: 9 mul, 6 add, 6 cmp`;
         /// `ops triangle-focal/hit: 13 mul, 10 add, 1 div, 15 cmp`.
-        TriangleFocal "triangle-focal", unit: false, error: Exact, focal_triangle;
+        TriangleFocal "triangle-focal", unit: false, error: Exact,
+            source: "raylane: rays from one eye", focal_triangle;
     }
     /// [`FocalUnguarded`](raylane::sphere::focal::FocalUnguarded): the lecture's unguarded focal
     /// test.
@@ -417,6 +434,7 @@ registry! {
         /// Per lane: `ops focal-unguarded/miss: 4 mul, 2 add, 1 cmp`;
         /// `ops focal-unguarded/hit: 4 mul, 5 add, 1 sqrt, 5 cmp`.
         FocalUnguarded "focal-unguarded", unit: true, error: Textbook,
+            source: "the same without the precision guard",
             focal_sphere(raylane::sphere::focal::FocalUnguarded, false);
     }
     /// The ray–plane test.
@@ -425,7 +443,8 @@ registry! {
         ///
         /// Per lane: `ops plane/miss: 6 mul, 7 add, 1 div, 2 cmp`;
         /// `ops plane/hit: 6 mul, 7 add, 1 div, 2 cmp`.
-        Plane "plane", unit: false, error: Exact, plane;
+        Plane "plane", unit: false, error: Exact,
+            source: "lecture 002", plane;
     }
     /// [`Cramer`](raylane::triangle::Cramer): lecture 002.
     Cramer "cramer" {
@@ -433,7 +452,8 @@ registry! {
         ///
         /// Per lane: `ops cramer/miss: 21 mul, 22 add, 2 div, 5 cmp`;
         /// `ops cramer/hit: 30 mul, 27 add, 3 div, 7 cmp`.
-        Cramer "cramer", unit: false, error: Needle, triangle(raylane::triangle::Cramer);
+        Cramer "cramer", unit: false, error: Needle,
+            source: "lecture 002 (Cramer's rule)", triangle(raylane::triangle::Cramer);
     }
     /// [`Moller`](raylane::triangle::Moller): Möller–Trumbore, division deferred.
     Moller "moller" {
@@ -441,7 +461,8 @@ registry! {
         ///
         /// Per lane: `ops moller/miss: 21 mul, 22 add, 5 cmp`;
         /// `ops moller/hit: 25 mul, 24 add, 1 div, 12 cmp`.
-        Moller "moller", unit: false, error: Needle, triangle(raylane::triangle::Moller);
+        Moller "moller", unit: false, error: Needle,
+            source: "Möller–Trumbore 1997, division deferred", triangle(raylane::triangle::Moller);
     }
     /// [`Watertight`](raylane::triangle::Watertight): Woop, Benthin, Wald 2013.
     Watertight "watertight" {
@@ -449,7 +470,8 @@ registry! {
         ///
         /// Per lane: `ops watertight/miss: 12 mul, 18 add, 6 cmp`;
         /// `ops watertight/hit: 19 mul, 22 add, 1 div, 15 cmp`.
-        Watertight "watertight", unit: false, error: Exact, triangle(raylane::triangle::Watertight);
+        Watertight "watertight", unit: false, error: Exact,
+            source: "Woop–Benthin–Wald 2013", triangle(raylane::triangle::Watertight);
     }
     /// [`Pbrt`](raylane::sphere::Pbrt): pbrt-v4's sphere test, without intervals.
     Pbrt "pbrt" {
@@ -457,7 +479,8 @@ registry! {
         ///
         /// Per lane: `ops pbrt/miss: 21 mul, 17 add, 1 div, 1 sqrt, 1 cmp`;
         /// `ops pbrt/hit: 22 mul, 18 add, 3 div, 2 sqrt, 7 cmp`.
-        Pbrt "pbrt", unit: false, error: RobustSphere, sphere(raylane::sphere::Pbrt);
+        Pbrt "pbrt", unit: false, error: RobustSphere,
+            source: "pbrt-v4, intervals aside", sphere(raylane::sphere::Pbrt);
     }
     /// [`EmbreeSphere`](raylane::sphere::EmbreeSphere): Embree's sphere test.
     EmbreeSphere "embree" {
@@ -466,7 +489,7 @@ registry! {
         /// Per lane: `ops embree/miss: 14 mul, 12 add, 1 div, 1 cmp`;
         /// `ops embree/hit: 15 mul, 15 add, 1 div, 1 sqrt, 5 cmp`.
         EmbreeSphere "embree", unit: false, error: RobustSphere,
-            sphere(raylane::sphere::EmbreeSphere);
+            source: "Embree sphere_intersector", sphere(raylane::sphere::EmbreeSphere);
     }
     /// [`Badouel`](raylane::triangle::Badouel): Badouel 1990, plane then a 2-D test.
     Badouel "badouel" {
@@ -474,7 +497,8 @@ registry! {
         ///
         /// Per lane: `ops badouel/miss: 23 mul, 28 add, 3 div, 9 cmp`;
         /// `ops badouel/hit: 23 mul, 28 add, 3 div, 9 cmp`.
-        Badouel "badouel", unit: false, error: Record, precomputed(raylane::triangle::Badouel);
+        Badouel "badouel", unit: false, error: Record,
+            source: "Badouel 1990", precomputed(raylane::triangle::Badouel);
     }
     /// [`Plucker`](raylane::triangle::Plucker): Plücker edge tests (Segura–Feito 1998, as in
     /// Embree).
@@ -483,7 +507,8 @@ registry! {
         ///
         /// Per lane: `ops plucker/miss: 28 mul, 44 add, 6 cmp`;
         /// `ops plucker/hit: 41 mul, 53 add, 1 div, 20 cmp`.
-        Plucker "plucker", unit: false, error: Needle, triangle(raylane::triangle::Plucker);
+        Plucker "plucker", unit: false, error: Needle,
+            source: "Segura–Feito 1998 (Embree's Plücker)", triangle(raylane::triangle::Plucker);
     }
     /// [`Wald`](raylane::triangle::Wald): Wald 2004, precomputed projection.
     Wald "wald" {
@@ -491,7 +516,8 @@ registry! {
         ///
         /// Per lane: `ops wald/miss: 31 mul, 25 add, 2 div, 9 cmp`;
         /// `ops wald/hit: 31 mul, 25 add, 2 div, 9 cmp`.
-        Wald "wald", unit: false, error: Record, precomputed(raylane::triangle::Wald);
+        Wald "wald", unit: false, error: Record,
+            source: "Wald 2004", precomputed(raylane::triangle::Wald);
     }
     /// [`HavelHerout`](raylane::triangle::HavelHerout): Havel–Herout 2010, precomputed planes.
     HavelHerout "havel-herout" {
@@ -500,7 +526,7 @@ registry! {
         /// Per lane: `ops havel-herout/miss: 56 mul, 39 add, 1 div, 5 cmp`;
         /// `ops havel-herout/hit: 57 mul, 39 add, 2 div, 12 cmp`.
         HavelHerout "havel-herout", unit: false, error: Record,
-            precomputed(raylane::triangle::HavelHerout);
+            source: "Havel–Herout 2010", precomputed(raylane::triangle::HavelHerout);
     }
     /// [`KenslerShirley`](raylane::triangle::KenslerShirley): Kensler–Shirley 2006.
     KenslerShirley "kensler-shirley" {
@@ -509,7 +535,7 @@ registry! {
         /// Per lane: `ops kensler-shirley/miss: 23 mul, 22 add, 1 div, 3 cmp`;
         /// `ops kensler-shirley/hit: 27 mul, 24 add, 1 div, 5 cmp`.
         KenslerShirley "kensler-shirley", unit: false, error: Needle,
-            triangle(raylane::triangle::KenslerShirley);
+            source: "Kensler–Shirley 2006", triangle(raylane::triangle::KenslerShirley);
     }
     /// [`BaldwinWeber`](raylane::triangle::BaldwinWeber): Baldwin–Weber 2016, precomputed affine
     /// transform.
@@ -519,7 +545,7 @@ registry! {
         /// Per lane: `ops baldwin-weber/miss: 37 mul, 30 add, 2 div, 8 cmp`;
         /// `ops baldwin-weber/hit: 37 mul, 30 add, 2 div, 8 cmp`.
         BaldwinWeber "baldwin-weber", unit: false, error: Record,
-            precomputed(raylane::triangle::BaldwinWeber);
+            source: "Baldwin–Weber 2016", precomputed(raylane::triangle::BaldwinWeber);
     }
 }
 

@@ -1,13 +1,19 @@
 //! The operation-count study: every ray–triangle and ray–sphere method, published or
 //! raylane's own, measured by the same counting lane (issue 13).
 //!
+//! The methods are the [registry](crate::registry)'s kernels of triangles and spheres
+//! ([`KERNELS`]: triangles first, then spheres, each in [`Kernel::ALL`]'s order; the plane
+//! tests are not methods of the study), each named by its checker's method (the focal caches
+//! of both shapes are `focal`) and its [`Kernel::source`]. Every function below takes a
+//! [`Kernel`] and reaches the kernel's type through [`Kernel::visit`].
+//!
 //! [`entries`] measures each method with [`Counted<f32>`](raylane::opcount::Counted) on the same
 //! worked examples as the op-count report ([`opcount::table`](crate::opcount::table), whose
-//! rows it reuses for raylane's own kernels): a **miss** (triangles: beyond edge BC, every
-//! method's latest exit; spheres: the lecture's miss ray), a **hit**, and for triangles a
-//! triangle **behind** the origin (where the methods that find the plane first exit early).
-//! It adds the **per-ray** setup (once per ray and query), the **bytes** each test reads per
-//! primitive (the three vertices, 36, or the method's precomputed record; for the focal
+//! rows it reuses for the sphere kernels and the focal caches): a **miss** (triangles: beyond
+//! edge BC, every method's latest exit; spheres: the lecture's miss ray), a **hit**, and for
+//! triangles a triangle **behind** the origin (where the methods that find the plane first exit
+//! early). It adds the **per-ray** setup (once per ray and query), the **bytes** each test reads
+//! per primitive (the three vertices, 36, or the method's precomputed record; for the focal
 //! caches, per primitive *and per eye*), and the **precomputation**'s own count, measured by
 //! running [`PrecomputedKernel::precompute`] under `Counted` (the focal caches are built with
 //! exact `f64` arithmetic and not counted).
@@ -21,36 +27,78 @@
 
 use core::fmt;
 use core::hint::black_box;
+use core::marker::PhantomData;
 use core::mem::size_of;
 
 use glam::Vec3;
 
-use crate::opcount::table;
+use crate::opcount::{Table, table};
+use crate::registry::{Family, Kernel, Prim, Visitor};
 use raylane::Cull;
+use raylane::kernel::LaneHit;
 use raylane::lane::{Lane, Mask};
 use raylane::opcount::{Counted, OpCounts, measure};
+use raylane::plane::{FocalPlane, Plane};
 use raylane::ray::{Ray, RayPacket};
-use raylane::sphere::focal::{Focal, FocalKernel, FocalUnguarded};
-use raylane::sphere::{
-    self, EmbreeSphere, FocalSphere, Geometric, Pbrt, Quadratic, QuadraticUnit, Robust,
-    SphereKernel, SpherePacket,
-};
+use raylane::sphere::focal::FocalKernel;
+use raylane::sphere::{self, FocalSphere, SphereKernel, SpherePacket};
 use raylane::triangle::focal::FocalRays;
 use raylane::triangle::{
-    Badouel, BaldwinWeber, Cramer, FocalTriangle, HavelHerout, KenslerShirley, Moller, Plucker,
-    PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, Wald, Watertight, focal as tf,
+    FocalTriangle, PrecomputedKernel, Triangle, TriangleKernel, TrianglePacket, focal as tf,
 };
 
 type C = Counted<f32>;
 
-/// What a method tests.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum Shape {
-    /// Ray–triangle.
-    Triangle,
-    /// Ray–sphere.
-    Sphere,
+/// What a method tests: the registry's [`Prim`] (the study's methods test triangles or
+/// spheres).
+pub use crate::registry::Prim as Shape;
+
+/// True for the kernels the study measures: those of triangles and spheres (the plane tests are
+/// not methods of the study).
+#[must_use]
+pub const fn studied(k: Kernel) -> bool {
+    !matches!(k.prim(), Prim::Plane)
 }
+
+/// How many kernels of the registry the study measures.
+const fn studied_count() -> usize {
+    let mut n = 0;
+    let mut i = 0;
+    while i < Kernel::ALL.len() {
+        if studied(Kernel::ALL[i]) {
+            n += 1;
+        }
+        i += 1;
+    }
+    n
+}
+
+/// [`KERNELS`], collected from the registry at compile time.
+const fn studied_kernels() -> [Kernel; studied_count()] {
+    let mut out = [Kernel::ALL[0]; studied_count()];
+    let mut n = 0;
+    let mut triangles = true;
+    loop {
+        let mut i = 0;
+        while i < Kernel::ALL.len() {
+            let k = Kernel::ALL[i];
+            if studied(k) && matches!(k.prim(), Prim::Triangle) == triangles {
+                out[n] = k;
+                n += 1;
+            }
+            i += 1;
+        }
+        if !triangles {
+            return out;
+        }
+        triangles = false;
+    }
+}
+
+/// The study's methods, in its table's order: the registry's kernels of triangles, then those
+/// of spheres, each in [`Kernel::ALL`]'s order (see [`studied`]). [`entries`] measures them
+/// and [`repeat`] times them in this order.
+pub const KERNELS: [Kernel; studied_count()] = studied_kernels();
 
 /// The precomputation a method needs per primitive.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -66,11 +114,14 @@ pub enum Precompute {
 /// One method of the study.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Entry {
-    /// The method's name (as the checker spells it).
+    /// The registry's kernel.
+    pub kernel: Kernel,
+    /// The method's name (as the checker spells it: [`Kernel::method`]'s name, `focal` for the
+    /// focal caches of both shapes).
     pub method: &'static str,
-    /// Triangles or spheres.
+    /// Triangles or spheres ([`Kernel::prim`]).
     pub shape: Shape,
-    /// The source, short.
+    /// The source, short ([`Kernel::source`]).
     pub source: &'static str,
     /// A miss.
     pub miss: OpCounts,
@@ -115,11 +166,12 @@ pub struct Insns {
     pub precompute: Option<f64>,
 }
 
-fn row(kernel: &str, path: &str) -> OpCounts {
-    table()
+/// The counts of the report's row `path` of kernel `kernel`, if it has one.
+fn row(table: &Table, kernel: &str, path: &str) -> Option<OpCounts> {
+    table
         .iter()
         .find(|r| r.kernel == kernel && r.path == path)
-        .map_or(OpCounts::default(), |r| r.counts)
+        .map(|r| r.counts)
 }
 
 /// The report's worked triangle, rays and sphere (see [`opcount::table`](crate::opcount::table)).
@@ -131,6 +183,7 @@ fn triangle() -> Triangle {
     )
 }
 
+/// The miss (beyond edge BC), the hit and the triangle behind the origin.
 fn triangle_rays() -> [Ray; 3] {
     let down = Vec3::new(0.0, 0.0, -1.0);
     [
@@ -177,177 +230,87 @@ fn sphere_rays() -> (Ray, Ray) {
     (miss, hit)
 }
 
-/// Miss and hit of a sphere kernel on the lecture's examples.
-fn sphere_counts<K: SphereKernel>() -> [OpCounts; 2] {
-    let ball = SpherePacket::<C>::splat(&ball());
-    let (miss, hit) = sphere_rays();
-    [miss, hit].map(|r| measure(|| K::roots(&RayPacket::<C>::splat(&r), &ball)).1)
+/// [`entries`]'s visitor: one kernel's entry.
+#[derive(Clone, Copy)]
+struct Study<'a> {
+    /// The op-count report, measured once.
+    table: &'a Table,
 }
 
-/// Every method of the study, triangles first.
-#[must_use]
-pub fn entries() -> [Entry; 18] {
-    let none = OpCounts::default();
-    let vertices = 3 * size_of::<Vec3>();
-    let ball = 4 * size_of::<f32>();
-    let tri = |method: &'static str,
-               source: &'static str,
-               c: [OpCounts; 3],
-               bytes: usize,
-               pre: Precompute| Entry {
-        method,
-        shape: Shape::Triangle,
-        source,
-        miss: c[0],
-        hit: c[1],
-        behind: Some(c[2]),
-        per_ray: none,
-        bytes,
-        pre,
-    };
-    let plain_entry = |method, source, c| tri(method, source, c, vertices, Precompute::None);
-    let pre_entry = |method, source, (c, pre): ([OpCounts; 3], OpCounts), bytes| {
-        tri(method, source, c, bytes, Precompute::Counted(pre))
-    };
-    let sphere = |method: &'static str,
-                  source: &'static str,
-                  c: [OpCounts; 2],
-                  bytes: usize,
-                  pre: Precompute| Entry {
-        method,
-        shape: Shape::Sphere,
-        source,
-        miss: c[0],
-        hit: c[1],
-        behind: None,
-        per_ray: none,
-        bytes,
-        pre,
-    };
-    let sphere_own = |method, kernel: &'static str, source, bytes, pre| {
-        sphere(
-            method,
-            source,
-            [row(kernel, "miss"), row(kernel, "hit")],
+impl Study<'_> {
+    /// Bytes of the three vertices.
+    const VERTICES: usize = 3 * size_of::<Vec3>();
+    /// Bytes of a sphere: centre and radius.
+    const BALL: usize = 4 * size_of::<f32>();
+
+    /// Kernel `k`'s entry with the counts of its rows in the op-count report (`behind` and
+    /// `per ray` where it has them).
+    fn report(self, k: Kernel, bytes: usize, pre: Precompute) -> Entry {
+        let row = |path| row(self.table, k.name(), path);
+        Entry {
+            kernel: k,
+            method: k.method().name(),
+            shape: k.prim(),
+            source: k.source(),
+            miss: row("miss").unwrap_or_default(),
+            hit: row("hit").unwrap_or_default(),
+            behind: row("behind"),
+            per_ray: row("per ray").unwrap_or_default(),
             bytes,
             pre,
-        )
-    };
-    let sphere_new = |method, source, c| sphere(method, source, c, ball, Precompute::None);
-    let focal_tri = Entry {
-        method: "focal",
-        shape: Shape::Triangle,
-        source: "raylane: rays from one eye",
-        miss: row("triangle-focal", "miss"),
-        hit: row("triangle-focal", "hit"),
-        behind: Some(row("triangle-focal", "behind")),
-        per_ray: row("triangle-focal", "per ray"),
-        bytes: size_of::<FocalTriangle<f32>>(),
-        pre: Precompute::PerEye,
-    };
-    let focal_bytes = size_of::<FocalSphere<f32>>();
-    [
-        plain_entry(
-            Cramer::NAME,
-            "lecture 002 (Cramer's rule)",
-            plain::<Cramer>(),
-        ),
-        plain_entry(
-            Moller::NAME,
-            "Möller–Trumbore 1997, division deferred",
-            plain::<Moller>(),
-        ),
+        }
+    }
+
+    /// A triangle kernel's entry with its miss, hit and behind counted here.
+    fn counted(self, k: Kernel, c: [OpCounts; 3], bytes: usize, pre: Precompute) -> Entry {
+        let [miss, hit, behind] = c;
         Entry {
-            per_ray: row("watertight", "per ray"),
-            ..plain_entry(
-                Watertight::NAME,
-                "Woop–Benthin–Wald 2013",
-                plain::<Watertight>(),
-            )
-        },
-        focal_tri,
-        pre_entry(
-            Badouel::NAME,
-            "Badouel 1990",
-            precomputed::<Badouel>(),
-            Badouel::BYTES,
-        ),
-        plain_entry(
-            Plucker::NAME,
-            "Segura–Feito 1998 (Embree's Plücker)",
-            plain::<Plucker>(),
-        ),
-        pre_entry(Wald::NAME, "Wald 2004", precomputed::<Wald>(), Wald::BYTES),
-        pre_entry(
-            HavelHerout::NAME,
-            "Havel–Herout 2010",
-            precomputed::<HavelHerout>(),
-            HavelHerout::BYTES,
-        ),
-        plain_entry(
-            KenslerShirley::NAME,
-            "Kensler–Shirley 2006",
-            plain::<KenslerShirley>(),
-        ),
-        pre_entry(
-            BaldwinWeber::NAME,
-            "Baldwin–Weber 2016",
-            precomputed::<BaldwinWeber>(),
-            BaldwinWeber::BYTES,
-        ),
-        sphere_own(
-            "quadratic",
-            "quadratic",
-            "the quadratic (lecture 004)",
-            ball,
-            Precompute::None,
-        ),
-        sphere_own(
-            "quadratic-unit",
-            "quadratic-unit",
-            "lecture 000, unit d",
-            ball,
-            Precompute::None,
-        ),
-        sphere_own(
-            "geometric",
-            "geometric",
-            "Glassner's geometric test, unit d",
-            ball,
-            Precompute::None,
-        ),
-        sphere_own(
-            "robust",
-            "robust",
-            "Ray Tracing Gems ch. 7",
-            ball,
-            Precompute::None,
-        ),
-        sphere_new(
-            Pbrt::NAME,
-            "pbrt-v4, intervals aside",
-            sphere_counts::<Pbrt>(),
-        ),
-        sphere_new(
-            EmbreeSphere::NAME,
-            "Embree sphere_intersector",
-            sphere_counts::<EmbreeSphere>(),
-        ),
-        sphere_own(
-            "focal",
-            "focal",
-            "raylane: rays from one eye, unit d",
-            focal_bytes,
-            Precompute::PerEye,
-        ),
-        sphere_own(
-            "focal-unguarded",
-            "focal-unguarded",
-            "the same without the precision guard",
-            focal_bytes,
-            Precompute::PerEye,
-        ),
-    ]
+            miss,
+            hit,
+            behind: Some(behind),
+            ..self.report(k, bytes, pre)
+        }
+    }
+}
+
+impl Visitor for Study<'_> {
+    type Output = Entry;
+
+    fn sphere<K: SphereKernel>(self, k: Kernel) -> Entry {
+        self.report(k, Self::BALL, Precompute::None)
+    }
+
+    fn focal_sphere<K: FocalKernel>(self, k: Kernel, _: bool) -> Entry {
+        self.report(k, size_of::<FocalSphere<f32>>(), Precompute::PerEye)
+    }
+
+    fn plane(self, k: Kernel) -> Entry {
+        self.report(k, size_of::<Plane>(), Precompute::None)
+    }
+
+    fn focal_plane(self, k: Kernel) -> Entry {
+        self.report(k, size_of::<FocalPlane>(), Precompute::PerEye)
+    }
+
+    fn triangle<K: TriangleKernel>(self, k: Kernel) -> Entry {
+        self.counted(k, plain::<K>(), Self::VERTICES, Precompute::None)
+    }
+
+    fn precomputed<K: TriangleKernel + PrecomputedKernel>(self, k: Kernel) -> Entry {
+        let (c, pre) = precomputed::<K>();
+        self.counted(k, c, K::BYTES, Precompute::Counted(pre))
+    }
+
+    fn focal_triangle(self, k: Kernel) -> Entry {
+        self.report(k, size_of::<FocalTriangle<f32>>(), Precompute::PerEye)
+    }
+}
+
+/// Every method of the study, one per kernel of [`KERNELS`], in its order (triangles first).
+#[must_use]
+pub fn entries() -> [Entry; KERNELS.len()] {
+    let table = table();
+    KERNELS.map(|k| k.visit(Study { table: &table }))
 }
 
 /// `mul·add·div·sqrt·cmp`, compact.
@@ -419,29 +382,6 @@ pub fn write_table(
     Ok(())
 }
 
-/// Every method of [`entries`], in its order: what [`repeat`] runs (`tests/suite/kernels/op_count_study.rs`
-/// checks that the two lists agree).
-pub const METHODS: [(Shape, &str); 18] = [
-    (Shape::Triangle, Cramer::NAME),
-    (Shape::Triangle, Moller::NAME),
-    (Shape::Triangle, Watertight::NAME),
-    (Shape::Triangle, "focal"),
-    (Shape::Triangle, Badouel::NAME),
-    (Shape::Triangle, Plucker::NAME),
-    (Shape::Triangle, Wald::NAME),
-    (Shape::Triangle, HavelHerout::NAME),
-    (Shape::Triangle, KenslerShirley::NAME),
-    (Shape::Triangle, BaldwinWeber::NAME),
-    (Shape::Sphere, "quadratic"),
-    (Shape::Sphere, "quadratic-unit"),
-    (Shape::Sphere, "geometric"),
-    (Shape::Sphere, "robust"),
-    (Shape::Sphere, Pbrt::NAME),
-    (Shape::Sphere, EmbreeSphere::NAME),
-    (Shape::Sphere, "focal"),
-    (Shape::Sphere, "focal-unguarded"),
-];
-
 /// The worked example a timed test runs on (see [`repeat`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Path {
@@ -462,20 +402,25 @@ pub const PATHS: [(Path, &str); 3] = [
     (Path::Precompute, "precompute"),
 ];
 
-/// Whether method `index` of [`METHODS`] has a precomputation (a record per primitive or a
-/// cache per primitive and eye).
+/// Whether method `k` of [`KERNELS`] has a precomputation (a record per primitive or a cache
+/// per primitive and eye) that [`repeat`] times; false for a kernel outside the study.
 #[must_use]
-pub const fn precomputes(index: usize) -> bool {
-    matches!(index, 3 | 4 | 6 | 7 | 9 | 16 | 17)
+pub const fn precomputes(k: Kernel) -> bool {
+    studied(k)
+        && matches!(
+            k.family(),
+            Family::Precomputed | Family::FocalSphere { .. } | Family::FocalTriangle
+        )
 }
 
-/// What one iteration of [`repeat`]'s loop does in lanes `L`: `L::LANES` ray–primitive tests
-/// or records, or one focal cache (built per primitive, not per lane).
+/// What one iteration of [`repeat`]'s loop does in lanes `L` for kernel `k`: `L::LANES`
+/// ray–primitive tests or records, or one focal cache (built per primitive, not per lane).
 #[must_use]
-pub fn units<L: Lane>(index: usize, path: Path) -> usize {
-    match (path, index) {
-        (Path::Precompute, 3 | 16 | 17) => 1,
-        _ => L::LANES,
+pub fn units<L: Lane>(k: Kernel, path: Path) -> usize {
+    if path == Path::Precompute && k.is_focal() {
+        1
+    } else {
+        L::LANES
     }
 }
 
@@ -493,134 +438,241 @@ fn tests<P, R>(n: usize, prim: &P, test: impl Fn(&P) -> R, hits: impl Fn(&R) -> 
     count
 }
 
-/// Runs the test of method `index` of [`METHODS`] `n` times on the worked example `path`, in
+/// Runs the test of method `k` of [`KERNELS`] `n` times on the worked example `path`, in
 /// lanes `L` (every lane the same ray and primitive), with the per-ray setup and the
 /// precomputation (records, focal caches) done once before the loop. Returns the lane hits
 /// (`n · L::LANES` on [`Path::Hit`], 0 on a miss; on [`Path::Precompute`], `n ·`
-/// [`units`] records or caches built, 0 for a method without any), or `None` past the last
-/// method.
+/// [`units`] records or caches built, 0 for a method without any), or `None` for a kernel the
+/// study does not measure (the plane tests: see [`studied`]).
 ///
 /// This is the unit the study's instruction counts are measured on (`scripts/count-study.sh`):
 /// the instructions executed inside one call with `n = 64`, minus those of a call with
 /// `n = 0`, divided by `64 · L::LANES`, are one ray–primitive test's, the loop's own
 /// bookkeeping (a counter, the hit count and the stored result) included.
 #[inline(never)]
-pub fn repeat<L: Lane<Scalar = f32>>(index: usize, path: Path, n: usize) -> Option<u32> {
-    let (shape, _) = *METHODS.get(index)?;
-    if path == Path::Precompute {
-        return Some(if precomputes(index) {
-            build::<L>(index, n)
-        } else {
-            0
-        });
+pub fn repeat<L: Lane<Scalar = f32>>(k: Kernel, path: Path, n: usize) -> Option<u32> {
+    match path {
+        Path::Precompute => build::<L>(k, n),
+        Path::Miss | Path::Hit => k.visit(Timed::<L> {
+            hit: path == Path::Hit,
+            n,
+            lanes: PhantomData,
+        }),
     }
-    let hit = path == Path::Hit;
-    Some(match shape {
-        Shape::Triangle => {
-            let ray = triangle_rays()[usize::from(hit)];
-            let rp = black_box(RayPacket::<L>::splat(&ray));
-            let tp = TrianglePacket::<L>::splat(&triangle());
-            let lane_hits = |h: &raylane::kernel::LaneHit<L>| h.mask.bits().count_ones();
-            fn plain<K: TriangleKernel, L: Lane<Scalar = f32>>(
-                n: usize,
-                rp: &RayPacket<L>,
-                tp: &TrianglePacket<L>,
-            ) -> u32 {
-                let pre = K::prepare(rp);
-                tests(
-                    n,
-                    tp,
-                    |t| K::intersect(rp, &pre, t, Cull::None),
-                    |h| h.mask.bits().count_ones(),
-                )
-            }
-            fn record<K: PrecomputedKernel, L: Lane<Scalar = f32>>(
-                n: usize,
-                rp: &RayPacket<L>,
-                tp: &TrianglePacket<L>,
-            ) -> u32 {
-                let rec = K::precompute(tp);
-                tests(
-                    n,
-                    &rec,
-                    |r| K::test(rp, r, Cull::None),
-                    |h| h.mask.bits().count_ones(),
-                )
-            }
-            match index {
-                0 => plain::<Cramer, L>(n, &rp, &tp),
-                1 => plain::<Moller, L>(n, &rp, &tp),
-                2 => plain::<Watertight, L>(n, &rp, &tp),
-                3 => {
-                    let e =
-                        FocalTriangle::<L>::splat(&FocalTriangle::new(ray.origin(), &triangle()));
-                    let fr = FocalRays::new(&rp);
-                    tests(n, &e, |e| tf::kernel(fr.scaled(), e, Cull::None), lane_hits)
-                }
-                4 => record::<Badouel, L>(n, &rp, &tp),
-                5 => plain::<Plucker, L>(n, &rp, &tp),
-                6 => record::<Wald, L>(n, &rp, &tp),
-                7 => record::<HavelHerout, L>(n, &rp, &tp),
-                8 => plain::<KenslerShirley, L>(n, &rp, &tp),
-                _ => record::<BaldwinWeber, L>(n, &rp, &tp),
-            }
-        }
-        Shape::Sphere => {
-            let (miss, hit_ray) = sphere_rays();
-            let ray = if hit { hit_ray } else { miss };
-            let rp = black_box(RayPacket::<L>::splat(&ray));
-            let ball = ball();
-            let sp = SpherePacket::<L>::splat(&ball);
-            let root_hits = |r: &sphere::Roots<L>| (r.m0 | r.m1).bits().count_ones();
-            fn roots<K: SphereKernel, L: Lane<Scalar = f32>>(
-                n: usize,
-                rp: &RayPacket<L>,
-                sp: &SpherePacket<L>,
-            ) -> u32 {
-                tests(
-                    n,
-                    sp,
-                    |s| K::roots(rp, s),
-                    |r| (r.m0 | r.m1).bits().count_ones(),
-                )
-            }
-            match index {
-                10 => roots::<Quadratic, L>(n, &rp, &sp),
-                11 => roots::<QuadraticUnit, L>(n, &rp, &sp),
-                12 => roots::<Geometric, L>(n, &rp, &sp),
-                13 => roots::<Robust, L>(n, &rp, &sp),
-                14 => roots::<Pbrt, L>(n, &rp, &sp),
-                15 => roots::<EmbreeSphere, L>(n, &rp, &sp),
-                16 => {
-                    let e = FocalSphere::<L>::splat(&FocalSphere::new(ray.origin(), &ball));
-                    tests(n, &e, |e| Focal::roots(&rp, e), root_hits)
-                }
-                _ => {
-                    let e = FocalSphere::<L>::splat(&FocalSphere::unguarded(ray.origin(), &ball));
-                    tests(n, &e, |e| FocalUnguarded::roots(&rp, e), root_hits)
-                }
-            }
-        }
-    })
+}
+
+/// Lane hits of a triangle test.
+fn lane_hits<L: Lane>(h: &LaneHit<L>) -> u32 {
+    h.mask.bits().count_ones()
+}
+
+/// Lane hits of a sphere test (either root).
+fn root_hits<L: Lane>(r: &sphere::Roots<L>) -> u32 {
+    (r.m0 | r.m1).bits().count_ones()
+}
+
+/// The timed loop of each family of kernels, on the packets, records and caches [`Timed`]
+/// sets up: each instance out of line, a function of its own, as the study's counts were
+/// measured (inlined into [`repeat`], a loop's registers would follow the dispatch around it).
+mod timed {
+    use super::{Cull, Lane, SpherePacket, lane_hits, root_hits, tests};
+    use super::{FocalKernel, FocalRays, FocalSphere, FocalTriangle, tf};
+    use super::{PrecomputedKernel, RayPacket, SphereKernel, TriangleKernel, TrianglePacket};
+
+    /// A triangle kernel's test, its per-ray setup before the loop.
+    #[inline(never)]
+    pub(super) fn plain<K: TriangleKernel, L: Lane<Scalar = f32>>(
+        n: usize,
+        rp: &RayPacket<L>,
+        tp: &TrianglePacket<L>,
+    ) -> u32 {
+        let pre = K::prepare(rp);
+        tests(n, tp, |t| K::intersect(rp, &pre, t, Cull::None), lane_hits)
+    }
+
+    /// A precomputed kernel's test on its record, built before the loop.
+    #[inline(never)]
+    pub(super) fn record<K: PrecomputedKernel, L: Lane<Scalar = f32>>(
+        n: usize,
+        rp: &RayPacket<L>,
+        tp: &TrianglePacket<L>,
+    ) -> u32 {
+        let rec = K::precompute(tp);
+        tests(n, &rec, |r| K::test(rp, r, Cull::None), lane_hits)
+    }
+
+    /// A sphere kernel's roots.
+    #[inline(never)]
+    pub(super) fn roots<K: SphereKernel, L: Lane<Scalar = f32>>(
+        n: usize,
+        rp: &RayPacket<L>,
+        sp: &SpherePacket<L>,
+    ) -> u32 {
+        tests(n, sp, |s| K::roots(rp, s), root_hits)
+    }
+
+    /// A focal kernel's roots on a sphere's cache, built before the loop.
+    #[inline(never)]
+    pub(super) fn focal_roots<K: FocalKernel, L: Lane<Scalar = f32>>(
+        n: usize,
+        rp: &RayPacket<L>,
+        e: &FocalSphere<L>,
+    ) -> u32 {
+        tests(n, e, |e| K::roots(rp, e), root_hits)
+    }
+
+    /// The focal test on a triangle's cache, built before the loop, its per-ray setup before
+    /// the loop.
+    #[inline(never)]
+    pub(super) fn focal<L: Lane<Scalar = f32>>(
+        n: usize,
+        rp: &RayPacket<L>,
+        e: &FocalTriangle<L>,
+    ) -> u32 {
+        let fr = FocalRays::new(rp);
+        tests(n, e, |e| tf::kernel(fr.scaled(), e, Cull::None), lane_hits)
+    }
+}
+
+/// [`repeat`]'s visitor on the miss and the hit: one kernel's timed loop.
+struct Timed<L> {
+    /// The hit (else the miss).
+    hit: bool,
+    /// Iterations.
+    n: usize,
+    /// The lane type.
+    lanes: PhantomData<L>,
+}
+
+impl<L: Lane<Scalar = f32>> Timed<L> {
+    /// The triangle ray of the path, in lanes the compiler cannot see through.
+    fn triangle_ray(&self) -> (Ray, RayPacket<L>) {
+        let [miss, hit, _] = triangle_rays();
+        let ray = if self.hit { hit } else { miss };
+        (ray, black_box(RayPacket::<L>::splat(&ray)))
+    }
+
+    /// The sphere ray of the path, in lanes the compiler cannot see through.
+    fn sphere_ray(&self) -> (Ray, RayPacket<L>) {
+        let (miss, hit) = sphere_rays();
+        let ray = if self.hit { hit } else { miss };
+        (ray, black_box(RayPacket::<L>::splat(&ray)))
+    }
+}
+
+impl<L: Lane<Scalar = f32>> Visitor for Timed<L> {
+    type Output = Option<u32>;
+
+    fn sphere<K: SphereKernel>(self, _: Kernel) -> Option<u32> {
+        let (_, rp) = self.sphere_ray();
+        let sp = SpherePacket::<L>::splat(&ball());
+        Some(timed::roots::<K, L>(self.n, &rp, &sp))
+    }
+
+    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) -> Option<u32> {
+        let (ray, rp) = self.sphere_ray();
+        let ball = ball();
+        let cache = if guarded {
+            FocalSphere::new(ray.origin(), &ball)
+        } else {
+            FocalSphere::unguarded(ray.origin(), &ball)
+        };
+        let e = FocalSphere::<L>::splat(&cache);
+        Some(timed::focal_roots::<K, L>(self.n, &rp, &e))
+    }
+
+    fn plane(self, _: Kernel) -> Option<u32> {
+        None
+    }
+
+    fn focal_plane(self, _: Kernel) -> Option<u32> {
+        None
+    }
+
+    fn triangle<K: TriangleKernel>(self, _: Kernel) -> Option<u32> {
+        let (_, rp) = self.triangle_ray();
+        let tp = TrianglePacket::<L>::splat(&triangle());
+        Some(timed::plain::<K, L>(self.n, &rp, &tp))
+    }
+
+    fn precomputed<K: TriangleKernel + PrecomputedKernel>(self, _: Kernel) -> Option<u32> {
+        let (_, rp) = self.triangle_ray();
+        let tp = TrianglePacket::<L>::splat(&triangle());
+        Some(timed::record::<K, L>(self.n, &rp, &tp))
+    }
+
+    fn focal_triangle(self, _: Kernel) -> Option<u32> {
+        let (ray, rp) = self.triangle_ray();
+        let e = FocalTriangle::<L>::splat(&FocalTriangle::new(ray.origin(), &triangle()));
+        Some(timed::focal(self.n, &rp, &e))
+    }
 }
 
 /// [`repeat`] on [`Path::Precompute`]: `n` records or caches of the worked primitive, each
-/// from a primitive the compiler must reload; returns how many were built.
-fn build<L: Lane<Scalar = f32>>(index: usize, n: usize) -> u32 {
-    fn record<K: PrecomputedKernel, L: Lane<Scalar = f32>>(n: usize) -> u32 {
-        let tp = TrianglePacket::<L>::splat(&triangle());
-        tests(n, &tp, |t| K::precompute(t), |_| L::LANES as u32)
+/// from a primitive the compiler must reload; returns how many were built (0 for a method
+/// without a precomputation, `None` outside the study).
+fn build<L: Lane<Scalar = f32>>(k: Kernel, n: usize) -> Option<u32> {
+    k.visit(Build::<L> {
+        n,
+        lanes: PhantomData,
+    })
+}
+
+/// [`build`]'s visitor.
+struct Build<L> {
+    /// Records or caches to build.
+    n: usize,
+    /// The lane type.
+    lanes: PhantomData<L>,
+}
+
+impl<L: Lane<Scalar = f32>> Visitor for Build<L> {
+    type Output = Option<u32>;
+
+    fn sphere<K: SphereKernel>(self, _: Kernel) -> Option<u32> {
+        Some(0)
     }
-    let eye = triangle_rays()[1].origin();
-    let sphere_eye = sphere_rays().1.origin();
-    match index {
-        3 => tests(n, &triangle(), |t| FocalTriangle::new(eye, t), |_| 1),
-        4 => record::<Badouel, L>(n),
-        6 => record::<Wald, L>(n),
-        7 => record::<HavelHerout, L>(n),
-        9 => record::<BaldwinWeber, L>(n),
-        16 => tests(n, &ball(), |b| FocalSphere::new(sphere_eye, b), |_| 1),
-        17 => tests(n, &ball(), |b| FocalSphere::unguarded(sphere_eye, b), |_| 1),
-        _ => 0,
+
+    fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) -> Option<u32> {
+        let eye = sphere_rays().1.origin();
+        let n = self.n;
+        Some(if guarded {
+            tests(n, &ball(), |b| FocalSphere::new(eye, b), |_| 1)
+        } else {
+            tests(n, &ball(), |b| FocalSphere::unguarded(eye, b), |_| 1)
+        })
+    }
+
+    fn plane(self, _: Kernel) -> Option<u32> {
+        None
+    }
+
+    fn focal_plane(self, _: Kernel) -> Option<u32> {
+        None
+    }
+
+    fn triangle<K: TriangleKernel>(self, _: Kernel) -> Option<u32> {
+        Some(0)
+    }
+
+    fn precomputed<K: TriangleKernel + PrecomputedKernel>(self, _: Kernel) -> Option<u32> {
+        let tp = TrianglePacket::<L>::splat(&triangle());
+        Some(tests(
+            self.n,
+            &tp,
+            |t| K::precompute(t),
+            |_| L::LANES as u32,
+        ))
+    }
+
+    fn focal_triangle(self, _: Kernel) -> Option<u32> {
+        let [_, hit, _] = triangle_rays();
+        let eye = hit.origin();
+        Some(tests(
+            self.n,
+            &triangle(),
+            |t| FocalTriangle::new(eye, t),
+            |_| 1,
+        ))
     }
 }

@@ -5,7 +5,8 @@
 //! Each method's timed loop ([`raylane_lab::study::repeat`], scalar `f32` lanes) runs between
 //! [`study_begin`] and [`study_end`] once over 64 iterations and once over none, on the miss,
 //! on the hit and on the precomputation (if any); the plugin prints one window per run.
-//! Output (semihosting): one `cfg SHAPE METHOD PATH UNITS N` line per window, in window order.
+//! Output (semihosting): one `cfg SHAPE METHOD PATH UNITS N` line per window, in window order
+//! (the methods in the order of [`raylane_lab::study::KERNELS`], the registry's).
 #![no_std]
 #![no_main]
 
@@ -13,7 +14,7 @@ use core::hint::black_box;
 
 use raylane_fw::semihosting::hprintln;
 use raylane_fw::{entry, exit};
-use raylane_lab::study::{METHODS, PATHS, Path, Shape, precomputes, repeat, units};
+use raylane_lab::study::{KERNELS, PATHS, Path, precomputes, repeat, units};
 
 raylane_fw::panic_exits!();
 
@@ -42,20 +43,17 @@ pub extern "C" fn study_end() {
 #[entry]
 fn main() -> ! {
     let mut ok = true;
-    for (i, (shape, method)) in METHODS.iter().enumerate() {
-        let shape = match shape {
-            Shape::Triangle => "triangle",
-            Shape::Sphere => "sphere",
-        };
+    for k in KERNELS {
+        let (shape, method) = (k.prim().name(), k.method().name());
         for (path, name) in PATHS {
-            if path == Path::Precompute && !precomputes(i) {
+            if path == Path::Precompute && !precomputes(k) {
                 continue;
             }
-            let units = units::<f32>(i, path);
+            let units = units::<f32>(k, path);
             for n in [64usize, 0] {
                 hprintln!("cfg {} {} {} {} {}", shape, method, name, units, n);
                 study_begin();
-                let done = repeat::<f32>(black_box(i), black_box(path), black_box(n));
+                let done = repeat::<f32>(black_box(k), black_box(path), black_box(n));
                 study_end();
                 let miss = path == Path::Miss;
                 ok &= done == Some(if miss { 0 } else { (units * n) as u32 });

@@ -4,9 +4,9 @@
 //! of the watertight harness. `examples/opcount.rs` includes this file to print the table;
 //! the test pins the copy in `docs/opcounts.md`.
 
-use raylane_lab::study::{self, Entry, Insns, Measured, Shape};
+use raylane_lab::study::{self, Entry, Insns, Measured};
 use raylane_lab::vectors::accuracy::{self, CLASSES};
-use raylane_lab::vectors::{Case, Kind, Method, Outcome};
+use raylane_lab::vectors::{Case, Kind, Outcome};
 
 use super::watertight_no_leaks as watertight;
 
@@ -41,10 +41,7 @@ fn insns() -> Vec<(String, String, String, String, f64)> {
 pub fn report() -> String {
     let insns = insns();
     let lookup = |target: &str, e: &Entry| -> Option<Insns> {
-        let shape = match e.shape {
-            Shape::Triangle => "triangle",
-            Shape::Sphere => "sphere",
-        };
+        let shape = e.shape.name();
         let get = |path: &str| {
             insns
                 .iter()
@@ -68,11 +65,8 @@ pub fn report() -> String {
     let mut cases = vec![Case::default(); 4096];
     let mut out = vec![Outcome::default(); 4096];
     let mut measured = |e: &Entry| {
-        let kind = match e.shape {
-            Shape::Triangle => Kind::Triangle,
-            Shape::Sphere => Kind::Sphere,
-        };
-        let method = Method::from_name(e.method).expect("every study method is in the checker");
+        let kind: Kind = e.shape;
+        let method = e.kernel.method();
         let mut m = Measured::default();
         let classes = CLASSES.iter().enumerate().filter(|(_, c)| c.kind == kind);
         for (slot, (k, c)) in m.accuracy.iter_mut().zip(classes) {
@@ -121,53 +115,65 @@ fn docs_study_table_is_the_report() {
 }
 
 #[test]
-fn the_timed_methods_are_the_entries() {
-    let names: Vec<_> = study::entries()
-        .iter()
-        .map(|e| (e.shape, e.method))
+fn the_entries_are_the_registry_kernels_of_triangles_then_spheres() {
+    use raylane_lab::registry::{Kernel, Prim};
+    let kernels: Vec<Kernel> = [Prim::Triangle, Prim::Sphere]
+        .into_iter()
+        .flat_map(Kernel::of)
         .collect();
-    assert_eq!(names, study::METHODS);
+    assert_eq!(study::KERNELS.to_vec(), kernels);
+    for (e, k) in study::entries().iter().zip(study::KERNELS) {
+        assert_eq!(e.kernel, k);
+        assert_eq!(
+            (e.method, e.shape, e.source),
+            (k.method().name(), k.prim(), k.source())
+        );
+    }
 }
 
 #[test]
 fn the_timed_loops_hit_and_miss_as_announced() {
-    use raylane_lab::study::{METHODS, Path, Precompute, entries, precomputes, repeat, units};
+    use raylane_lab::registry::Kernel;
+    use raylane_lab::study::{KERNELS, Path, Precompute, entries, precomputes, repeat, units};
     use wide::f32x8;
-    let entries = entries();
-    for (i, m) in METHODS.iter().enumerate() {
-        assert_eq!(repeat::<f32>(i, Path::Miss, 3), Some(0), "{m:?}");
-        assert_eq!(repeat::<f32>(i, Path::Hit, 3), Some(3), "{m:?}");
-        assert_eq!(repeat::<f32x8>(i, Path::Hit, 2), Some(16), "{m:?}");
-        assert_eq!(precomputes(i), entries[i].pre != Precompute::None, "{m:?}");
-        let built = if precomputes(i) {
-            2 * units::<f32x8>(i, Path::Precompute)
+    for (k, e) in KERNELS.into_iter().zip(entries()) {
+        let m = k.name();
+        assert_eq!(repeat::<f32>(k, Path::Miss, 3), Some(0), "{m}");
+        assert_eq!(repeat::<f32>(k, Path::Hit, 3), Some(3), "{m}");
+        assert_eq!(repeat::<f32x8>(k, Path::Hit, 2), Some(16), "{m}");
+        assert_eq!(precomputes(k), e.pre != Precompute::None, "{m}");
+        let built = if precomputes(k) {
+            2 * units::<f32x8>(k, Path::Precompute)
         } else {
             0
         };
         assert_eq!(
-            repeat::<f32x8>(i, Path::Precompute, 2),
+            repeat::<f32x8>(k, Path::Precompute, 2),
             Some(built as u32),
-            "{m:?}"
+            "{m}"
         );
     }
-    assert_eq!(repeat::<f32>(METHODS.len(), Path::Hit, 1), None);
+    // The plane tests are not methods of the study.
+    for k in [Kernel::Plane, Kernel::PlaneFocal] {
+        assert!(!KERNELS.contains(&k) && !precomputes(k));
+        for (path, _) in study::PATHS {
+            assert_eq!(repeat::<f32>(k, path, 1), None, "{}", k.name());
+        }
+    }
 }
 
 #[test]
 fn every_method_has_its_instruction_counts() {
     let insns = insns();
     for target in ["x86-64-v3", "cortex-m4f"] {
-        for (i, (shape, method)) in study::METHODS.into_iter().enumerate() {
-            let shape = match shape {
-                Shape::Triangle => "triangle",
-                Shape::Sphere => "sphere",
-            };
+        for k in study::KERNELS {
+            let (shape, method) = (k.prim().name(), k.method().name());
             for (path, name) in study::PATHS {
                 let n = insns
                     .iter()
                     .filter(|r| r.0 == target && r.1 == shape && r.2 == method && r.3 == name)
                     .count();
-                let want = usize::from(path != study::Path::Precompute || study::precomputes(i));
+                let want = usize::from(path != study::Path::Precompute || study::precomputes(k));
                 assert_eq!(
                     n, want,
                     "{target} {shape} {method} {name} in docs/study-insns.txt"
