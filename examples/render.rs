@@ -674,10 +674,10 @@ fn bunny_fw(o: &Options) -> (&'static str, Picture, usize) {
     let cam = bunny::camera(&tris, w, h);
     let mut rgb = vec![0u8; 3 * w as usize * h as usize];
     let hits = match o.lanes {
-        1 => bunny::render::<f32>(&tree, &cam, &mut rgb),
-        4 => bunny::render::<f32x4>(&tree, &cam, &mut rgb),
-        8 => bunny::render::<f32x8>(&tree, &cam, &mut rgb),
-        _ => bunny::render::<f32x16>(&tree, &cam, &mut rgb),
+        1 => bunny::render::<f32, _>(&tree, &cam, &mut rgb),
+        4 => bunny::render::<f32x4, _>(&tree, &cam, &mut rgb),
+        8 => bunny::render::<f32x8, _>(&tree, &cam, &mut rgb),
+        _ => bunny::render::<f32x16, _>(&tree, &cam, &mut rgb),
     };
     debug_assert!(hits.is_some(), "the image buffer is sized for the camera");
     let pic = Picture {

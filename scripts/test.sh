@@ -164,6 +164,7 @@ for b in "${boards[@]}"; do
   status=0
   timed "$name" cargo run --quiet --release --target "$target" --bin vectors > "$log" 2>&1 || status=$?
   grep -v '^digest' "$log" | grep -E 'FAILED|differs|cannot|panicked' || true
+  grep '^vectors stack' "$log" | sed "s/^/$name ($board): /" || true
   tail -n 1 "$log" | sed "s/^/$name ($board): /"
   [ "$status" -eq 0 ] || fail "$name firmware exited with $status (see $log)"
   grep -qE '^[0-9]+ passed, 0 failed$' "$log" || fail "$name firmware printed no result (see $log)"
@@ -240,17 +241,22 @@ for lanes in 1 4 8 16; do
 done
 echo "firmware images (${renders[*]}) equal to the host's at 1, 4, 8 and 16 lanes ($(wc -c < target/render/cortex-m4f.ppm) bytes)"
 
-step "firmware BVH vs host: the vendored bunny's BVH built and traversed on M3, M4F, M33, rv32imac, rv32imafc, byte for byte"
-# targets/src/bin/bvh.rs builds the tree on the device, renders 64x48 primary rays at 1, 4, 8
-# and 16 lanes (checking that they agree) and writes the image; the host renders the same
-# picture with the same code (raylane::demo::bunny) at each width.
+step "firmware BVH from flash vs host: the bunny baked on the host, traced on all six boards, byte for byte"
+# targets/build.rs bakes the vendored bunny (raylane::bvh::bake) into the `bvh` binary's flash;
+# targets/src/bin/bvh.rs opens it in place (Baked::open checks it, copies nothing), renders
+# 64x48 primary rays at 1 lane (and at 4, 8 and 16 lanes, checking they agree, on every board
+# but the Cortex-M0, whose flash holds the scalar path only) and writes the image; the host
+# renders the same picture with the same code (raylane_lab::demo::bunny) at each width.
 mkdir -p target/bvh
 cd "$root/targets"
 bvhs=()
+: > "$root/target/bvh/memory.md"
+{
+  echo "| target | core (QEMU board) | flash: code + tree + rest = used of linked size | RAM: .data+.bss; one query's stack; the program's peak; of linked size | largest mesh in the free flash |"
+  echo "| --- | --- | --- | --- | ---: |"
+} >> "$root/target/bvh/memory.md"
 for b in "${boards[@]}"; do
   IFS=: read -r name target board <<< "$b"
-  # The Cortex-M0's 16 KB of RAM cannot hold the tree (its `bvh` only says so).
-  [ "$name" != cortex-m0 ] || continue
   bvhs+=("$name")
   log="$root/target/bvh/$name.log"
   rm -f target/bvh.ppm "$root/target/bvh/$name.ppm"
@@ -263,8 +269,19 @@ for b in "${boards[@]}"; do
   elf="target/$target/release/bvh"
   read -r text rodata data bss < <("$(tools "$target")-size" -A -d "$elf" \
     | awk '$1==".text"{t=$2} $1==".rodata"{r=$2} $1==".data"{d=$2} $1==".bss"{b=$2} END{print t+0, r+0, d+0, b+0}')
-  stack=$(awk '/^bvh stack storage:/ { print $4 }' "$log")
-  echo "$name bvh: flash $((text + rodata + data)) B (.text $text, .rodata $rodata incl. the 44 KB mesh, .data $data); RAM $((data + bss)) B .data+.bss + ${stack:-?} B of arrays on the stack"
+  tree=$(sed -n 's/^bvh bunny: baked .*: \([0-9]*\) B in flash.*/\1/p' "$log")
+  tris=$(sed -n 's/^bvh bunny: baked \([0-9]*\) triangles.*/\1/p' "$log")
+  query=$(sed -n 's/^bvh stack: one query \([0-9]*\) B.*/\1/p' "$log")
+  peak=$(sed -n 's/^bvh stack: .*the whole program \([0-9]*\) B.*/\1/p' "$log")
+  [ -n "$tree" ] && [ -n "$query" ] || fail "$name bvh firmware printed no sizes (see $log)"
+  # The board's flash, from the memory.x that targets/build.rs links for the target.
+  case "$board" in virt) mem=memory/riscv-virt.x ;; *) mem=memory/$board.x ;; esac
+  kb() { awk -v r="$1" '$1 == r { v = $NF; print (v ~ /M/ ? v * 1024 : v + 0) }' "$mem"; }
+  size_k=$(kb FLASH); ram_k=$(kb RAM)
+  flash=$((size_k * 1024)); used=$((text + rodata + data))
+  # Free flash over the bunny's bytes per triangle: the largest mesh of its kind that would fit.
+  fits=$(( (flash - used + tree) * tris / tree ))
+  echo "| \`$target\` | $name ($board) | $text + $tree + $((rodata + data - tree)) = $used B of $size_k KB | $((data + bss)) B; $query B; $peak B; of $ram_k KB | $fits triangles |" >> "$root/target/bvh/memory.md"
 done
 cd "$root"
 for lanes in 1 4 8 16; do
@@ -276,6 +293,8 @@ for lanes in 1 4 8 16; do
   done
 done
 echo "firmware BVH images (${bvhs[*]}) equal to the host's at 1, 4, 8 and 16 lanes"
+echo "the baked bunny on each board (flash and RAM as linked and as measured by stack painting):"
+cat target/bvh/memory.md
 
 step "summary: every configuration, its digest, code size and digest run time"
 # The digest: the first 16 hex digits of the MD5 of the configuration's digest lines (the

@@ -75,6 +75,34 @@ fn main() {
     }
     src.push_str("];\n");
     fs::write(out.join("files.rs"), src).unwrap();
+
+    // The vendored bunny, baked for flash (the `bvh` binary links it with include_baked!).
+    let bunny =
+        PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").unwrap()).join("../tests/data/bunny.bin");
+    println!("cargo:rerun-if-changed={}", bunny.display());
+    let (positions, indices) = load_bunny(&fs::read(&bunny).expect("tests/data/bunny.bin"));
+    let mesh = raylane::mesh::Mesh::new(&positions, &indices);
+    let baked = raylane::bvh::bake::bake(&mesh).expect("the bunny bakes");
+    fs::write(out.join("bunny.rlbv"), baked).unwrap();
+}
+
+/// `tests/data/bunny.bin`: u32 vertex count, u32 triangle count, f32 x, y, z per vertex, u16
+/// a, b, c per triangle, little-endian.
+fn load_bunny(b: &[u8]) -> (Vec<raylane::glam::Vec3>, Vec<[u32; 3]>) {
+    let u32_at = |o: usize| u32::from_le_bytes(b[o..o + 4].try_into().unwrap());
+    let f32_at = |o: usize| f32::from_le_bytes(b[o..o + 4].try_into().unwrap());
+    let (nv, nt) = (u32_at(0) as usize, u32_at(4) as usize);
+    let pos = (0..nv)
+        .map(|i| {
+            raylane::glam::Vec3::new(f32_at(8 + 12 * i), f32_at(12 + 12 * i), f32_at(16 + 12 * i))
+        })
+        .collect();
+    let base = 8 + 12 * nv;
+    let h = |o: usize| u32::from(u16::from_le_bytes(b[o..o + 2].try_into().unwrap()));
+    let idx = (0..nt)
+        .map(|i| [h(base + 6 * i), h(base + 6 * i + 2), h(base + 6 * i + 4)])
+        .collect();
+    (pos, idx)
 }
 
 /// Per case, little-endian: kind (u8: 0 sphere, 1 plane, 2 triangle), the number of expected

@@ -38,7 +38,15 @@ impl Table {
             len: 0,
         }
     }
+}
 
+/// Where the report's rows go: a [`Table`], or a callback ([`each_row`]).
+trait Rows {
+    /// One row.
+    fn push(&mut self, kernel: &'static str, path: &'static str, counts: OpCounts);
+}
+
+impl Rows for Table {
     /// Adds a row (dropped past [`MAX_ROWS`]; a test checks the report fits).
     fn push(&mut self, kernel: &'static str, path: &'static str, counts: OpCounts) {
         if let Some(slot) = self.rows.get_mut(self.len) {
@@ -88,19 +96,40 @@ impl IntoIterator for Table {
 /// culling test of [`Bound::may_hit`](raylane::bounds::Bound::may_hit), per ray and mesh.
 #[must_use]
 pub fn table() -> Table {
-    use crate::registry::{Kernel, Prim};
     let mut t = Table::new();
+    fill(&mut t);
+    t
+}
+
+/// The rows of [`table`], one call of `f` each, in order, without storing them (the firmware
+/// prints them as they come: a [`Table`] is 3.5 KB, a fifth of a Cortex-M0's RAM).
+pub fn each_row(f: impl FnMut(Row)) {
+    struct Each<F>(F);
+    impl<F: FnMut(Row)> Rows for Each<F> {
+        fn push(&mut self, kernel: &'static str, path: &'static str, counts: OpCounts) {
+            (self.0)(Row {
+                kernel,
+                path,
+                counts,
+            });
+        }
+    }
+    fill(&mut Each(f));
+}
+
+/// Every row of the report into `t`.
+fn fill(t: &mut dyn Rows) {
+    use crate::registry::{Kernel, Prim};
     let ex = examples::Examples::new();
     for prim in Prim::ALL {
         for k in Kernel::of(prim) {
-            k.visit(examples::Paths { t: &mut t, ex: &ex });
+            k.visit(examples::Paths { t, ex: &ex });
         }
         if prim == Prim::Sphere {
-            examples::sphere_extras(&mut t, &ex);
+            examples::sphere_extras(t, &ex);
         }
     }
-    examples::bound(&mut t, &ex);
-    t
+    examples::bound(t, &ex);
 }
 
 mod examples {
@@ -108,7 +137,7 @@ mod examples {
 
     use glam::Vec3;
 
-    use super::{Counted, OpCounts, Table, measure};
+    use super::{Counted, OpCounts, Rows, measure};
     use crate::registry::{Kernel, Visitor};
     use raylane::Cull;
     use raylane::plane::{self, FocalPlane, Plane, PlanePacket};
@@ -210,7 +239,7 @@ mod examples {
 
     /// Every path of one kernel into the table.
     pub(super) struct Paths<'a> {
-        pub(super) t: &'a mut Table,
+        pub(super) t: &'a mut dyn Rows,
         pub(super) ex: &'a Examples,
     }
 
@@ -281,7 +310,7 @@ mod examples {
     }
 
     /// The prepared geometric test and the hit point with and without its normal.
-    pub(super) fn sphere_extras(t: &mut Table, ex: &Examples) {
+    pub(super) fn sphere_extras(t: &mut dyn Rows, ex: &Examples) {
         let ball = ex.ball;
         let prepared = |r: &Ray| {
             let rp = RayPacket::<C>::splat(r);
@@ -308,7 +337,7 @@ mod examples {
     }
 
     /// The bounding-sphere test per ray and mesh.
-    pub(super) fn bound(t: &mut Table, ex: &Examples) {
+    pub(super) fn bound(t: &mut dyn Rows, ex: &Examples) {
         let b = raylane::bounds::Bound::new(&sp::Sphere::new(Vec3::new(2.0, 1.5, 0.0), 2.5));
         let rp = RayPacket::<C>::splat(&ex.t_hit);
         t.push("bound", "per mesh", measure(|| b.may_hit(&rp)).1);

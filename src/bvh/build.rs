@@ -290,6 +290,19 @@ pub(crate) fn build<'s, P: Primitives + ?Sized>(
     leaves: &'s mut [P::Leaf],
     scratch: &mut [Scratch],
 ) -> Result<Bvh<'s, P::Leaf>, BuildError> {
+    build_width(prims, nodes, leaves, scratch, WIDTH)
+}
+
+/// [`build`] with at most `width` (2 to [`WIDTH`]) children per node (the others empty):
+/// the base of the 4-wide layout a bake converts.
+pub(crate) fn build_width<'s, P: Primitives + ?Sized>(
+    prims: &P,
+    nodes: &'s mut [Node],
+    leaves: &'s mut [P::Leaf],
+    scratch: &mut [Scratch],
+    width: usize,
+) -> Result<Bvh<'s, P::Leaf>, BuildError> {
+    let width = width.clamp(2, WIDTH);
     let n = prims.count();
     if n > MAX_PRIMITIVES {
         return Err(BuildError::TooMany);
@@ -338,7 +351,7 @@ pub(crate) fn build<'s, P: Primitives + ?Sized>(
         // Children as ranges; split the one of largest area until WIDTH or all are leaves.
         let mut kids = [Part { start, end, b, cb }; WIDTH];
         let mut nk = 1;
-        while nk < WIDTH {
+        while nk < width {
             // SAH levels split the largest area, middle-index levels the largest count (so
             // that each level divides the largest range by 8: the depth bound).
             // Equal areas (coincident primitives): the larger count.

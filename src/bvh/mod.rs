@@ -112,6 +112,7 @@
 //! `(t_min, t_max)` — so the tree and brute force agree for every `t_max`, finite or not, and
 //! `any`, `all` and `closest` agree with each other.
 
+pub mod bake;
 mod build;
 mod leaf;
 pub mod node;
@@ -119,7 +120,7 @@ pub mod scene;
 mod traverse;
 
 pub use leaf::{Leaf, Packed, Primitives, Sphere4, Tri4};
-pub use node::{Layout, Node};
+pub use node::{Layout, Node, Node4};
 pub use scene::{Inst4, Instance, Scene};
 
 use wide::f32x4;
@@ -385,12 +386,13 @@ impl<'s, P: Packed, N: Layout> Bvh<'s, P, N> {
 /// child does not follow its parent.
 fn depth<N: Layout>(nodes: &[N]) -> Option<u32> {
     let mut stack = [(0u32, 1u32); STACK];
+    let max_depth = N::MAX_DEPTH.min(MAX_DEPTH);
     let (mut sp, mut visits, mut deepest) = (1usize, 0usize, 0u32);
     while sp > 0 {
         sp -= 1;
         let (i, d) = stack[sp];
         visits += 1;
-        if visits > nodes.len() || d > MAX_DEPTH {
+        if visits > nodes.len() || d > max_depth {
             return None;
         }
         deepest = deepest.max(d);

@@ -11,9 +11,9 @@
 //! interval arithmetic ([`Frustum`]), conservative by monotonic rounding.
 
 use glam::Vec3;
-use wide::f32x8;
+use wide::{f32x4, f32x8, i32x4};
 
-use super::{EMPTY, WIDTH};
+use super::{EMPTY, MAX_DEPTH, STACK, WIDTH};
 use crate::lane::{Lane, Mask, Scalar};
 use crate::ray::RayPacket;
 
@@ -21,6 +21,14 @@ use crate::ray::RayPacket;
 pub trait Layout: Copy + core::fmt::Debug {
     /// A node with no children.
     const EMPTY: Self;
+    /// The deepest tree of this layout a traversal takes (the root alone is 1).
+    const MAX_DEPTH: u32;
+    /// The stack a traversal tries first (one that overflows it runs again with [`Full`]).
+    ///
+    /// [`Full`]: Self::Full
+    type Short: Entries;
+    /// The stack no tree of at most [`MAX_DEPTH`](Self::MAX_DEPTH) levels overflows.
+    type Full: Entries;
     /// Child `k`'s reference: [`EMPTY`], `LEAF | leaf index`, or an inner node's index.
     fn child(&self, k: usize) -> u32;
     /// Child `k`'s box (`min > max` for an empty slot).
@@ -41,6 +49,105 @@ pub trait Layout: Copy + core::fmt::Debug {
         t_max: L,
         active: L::Mask,
     ) -> (L::Mask, L);
+}
+
+/// What a traversal needs of its stack: node references with the entry parameters of their
+/// boxes, last in first out; a push that does not fit is recorded (the traversal then runs
+/// again with a larger stack).
+pub trait Entries {
+    /// An empty stack.
+    fn new() -> Self;
+    /// The last entry pushed, removed.
+    fn pop(&mut self) -> Option<(u32, f32)>;
+    /// Pushes an entry (or records the overflow).
+    fn push(&mut self, node: u32, t: f32);
+    /// True when a push did not fit.
+    fn overflowed(&self) -> bool;
+}
+
+/// A stack of `N` node references alone (4 bytes each; a popped entry's parameter is `−inf`,
+/// so the traversal prunes at the node's own test rather than before it): the small stack of
+/// [`Node4`] traversals.
+#[derive(Debug)]
+pub struct Refs<const N: usize> {
+    node: [u32; N],
+    len: usize,
+    overflow: bool,
+}
+
+impl<const N: usize> Entries for Refs<N> {
+    #[inline(always)]
+    fn new() -> Self {
+        Refs {
+            node: [0; N],
+            len: 0,
+            overflow: false,
+        }
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(u32, f32)> {
+        self.len = self.len.checked_sub(1)?;
+        Some((*self.node.get(self.len)?, f32::NEG_INFINITY))
+    }
+
+    #[inline(always)]
+    fn push(&mut self, node: u32, _: f32) {
+        if let Some(a) = self.node.get_mut(self.len) {
+            *a = node;
+            self.len += 1;
+        } else {
+            self.overflow = true;
+        }
+    }
+
+    #[inline(always)]
+    fn overflowed(&self) -> bool {
+        self.overflow
+    }
+}
+
+/// A traversal stack of `N` entries, 8 bytes each, on the call stack.
+#[derive(Debug)]
+pub struct Stack<const N: usize> {
+    node: [u32; N],
+    tn: [f32; N],
+    len: usize,
+    overflow: bool,
+}
+
+impl<const N: usize> Entries for Stack<N> {
+    #[inline(always)]
+    fn new() -> Self {
+        Stack {
+            node: [0; N],
+            tn: [0.0; N],
+            len: 0,
+            overflow: false,
+        }
+    }
+
+    #[inline(always)]
+    fn pop(&mut self) -> Option<(u32, f32)> {
+        self.len = self.len.checked_sub(1)?;
+        Some((*self.node.get(self.len)?, *self.tn.get(self.len)?))
+    }
+
+    #[inline(always)]
+    fn push(&mut self, node: u32, t: f32) {
+        if let (Some(a), Some(b)) = (self.node.get_mut(self.len), self.tn.get_mut(self.len)) {
+            *a = node;
+            *b = t;
+            self.len += 1;
+        } else {
+            self.overflow = true;
+        }
+    }
+
+    #[inline(always)]
+    fn overflowed(&self) -> bool {
+        self.overflow
+    }
 }
 
 /// One inner node of 8 children, their boxes in structure-of-arrays lanes: one `f32x8` slab
@@ -82,6 +189,9 @@ impl Default for Node {
 
 impl Layout for Node {
     const EMPTY: Self = Node::EMPTY;
+    const MAX_DEPTH: u32 = MAX_DEPTH;
+    type Short = Stack<32>;
+    type Full = Stack<STACK>;
 
     #[inline(always)]
     fn child(&self, k: usize) -> u32 {
@@ -117,6 +227,180 @@ impl Layout for Node {
         slab.test(&self.bounds, k, t_min, t_max, active)
     }
 }
+
+/// The deepest [`Node4`] tree (the root alone is 1; a binned-SAH tree of a million triangles
+/// in 4-wide nodes is about 12 deep): its traversal stack is [`STACK4`] node references, 196
+/// bytes.
+pub const MAX_DEPTH4: u32 = 16;
+/// Entries of a [`Node4`] traversal's stack: at most 3 siblings wait per level, plus one.
+pub const STACK4: usize = 3 * MAX_DEPTH4 as usize + 1;
+
+/// A compact node of up to 4 children (56 bytes, 14 per child, against [`Node`]'s 28): the
+/// children's boxes quantized to 8 bits inside the node's own box, rounded outward — for
+/// trees baked on a host and traced from a microcontroller's flash ([`super::bake`]).
+///
+/// Child `k`'s box on axis `a` decodes as `origin[a] + q·2^exp[a]` with `q = lo[a][k]` and
+/// `hi[a][k]` (`q` converted exactly, the product exact, one rounded addition: the same bits
+/// on every target). The baker picks the largest `lo` and the smallest `hi` whose decoded
+/// values still enclose the child's box, computing the decoding exactly as the traversal
+/// does, so every decoded box contains its child: a traversal over decoded boxes is as
+/// conservative as one over the exact boxes, and every answer stays brute force's. An unused
+/// slot has `child = EMPTY`, `lo = 255`, `hi = 0` (an empty box).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub struct Node4 {
+    /// The node box's minimum x, y, z: the decoding's origin.
+    pub origin: [f32; 3],
+    /// Per axis, the exponent `e` of the quantum `2^e` (`−126…127`).
+    pub exp: [i8; 3],
+    /// Zero.
+    pub pad: u8,
+    /// Children's quantized minimum x, y, z: `lo[axis][k]`.
+    pub lo: [[u8; 4]; 3],
+    /// Children's quantized maximum x, y, z.
+    pub hi: [[u8; 4]; 3],
+    /// Children: [`EMPTY`], an inner node's index, or a leaf: `LEAF | first << 2 | (count −
+    /// 1)`, triangles `first .. first + count` of the baked mesh (1 to 4 of them).
+    pub child: [u32; 4],
+}
+
+/// `2^e` for `−126 ≤ e ≤ 127` (other `e` give 0 or +inf).
+#[inline(always)]
+pub(crate) fn pow2(e: i8) -> f32 {
+    let e = i32::from(e);
+    if (-126..=127).contains(&e) {
+        f32::from_bits(((127 + e) as u32) << 23)
+    } else if e > 127 {
+        f32::INFINITY
+    } else {
+        0.0
+    }
+}
+
+impl Node4 {
+    /// A node with no children.
+    pub const EMPTY: Node4 = Node4 {
+        origin: [0.0; 3],
+        exp: [0; 3],
+        pad: 0,
+        lo: [[255; 4]; 3],
+        hi: [[0; 4]; 3],
+        child: [EMPTY; 4],
+    };
+
+    /// The decoded value of `q` on axis `a` (see the type's docs).
+    #[inline(always)]
+    #[must_use]
+    pub fn decode(&self, a: usize, q: u8) -> f32 {
+        let (o, e) = (
+            self.origin.get(a).copied().unwrap_or(f32::NAN),
+            self.exp.get(a).copied().unwrap_or(0),
+        );
+        o + f32::from(q) * pow2(e)
+    }
+
+    /// The children's decoded boxes as [`Node::bounds`] rows (min x, y, z, max x, y, z;
+    /// lanes 4 to 7 and unused slots empty: `+inf`, `−inf`).
+    #[inline(always)]
+    #[must_use]
+    pub fn rows(&self) -> [[f32; WIDTH]; 6] {
+        let mut r = Node::EMPTY.bounds;
+        for (k, &c) in self.child.iter().enumerate() {
+            if c == EMPTY {
+                continue;
+            }
+            for a in 0..3 {
+                r[a][k] = self.decode(a, self.lo[a][k]);
+                r[3 + a][k] = self.decode(a, self.hi[a][k]);
+            }
+        }
+        r
+    }
+
+    /// The children's decoded boxes in four lanes, rows as [`rows`](Self::rows) (unused slots
+    /// decode to their canonical `lo = 255`, `hi = 0`: [`Slab::test4`] leaves them out by
+    /// `child`). One decoding per row in lanes, each lane's value [`decode`](Self::decode)'s.
+    #[inline(always)]
+    #[must_use]
+    pub fn rows4(&self) -> [f32x4; 6] {
+        let row = |a: usize, q: &[u8; 4]| {
+            let q = i32x4::new(q.map(i32::from)).round_float();
+            f32x4::splat(self.origin[a]) + q * f32x4::splat(pow2(self.exp[a]))
+        };
+        [
+            row(0, &self.lo[0]),
+            row(1, &self.lo[1]),
+            row(2, &self.lo[2]),
+            row(0, &self.hi[0]),
+            row(1, &self.hi[1]),
+            row(2, &self.hi[2]),
+        ]
+    }
+}
+
+impl Default for Node4 {
+    fn default() -> Self {
+        Node4::EMPTY
+    }
+}
+
+impl Layout for Node4 {
+    const EMPTY: Self = Node4::EMPTY;
+    const MAX_DEPTH: u32 = MAX_DEPTH4;
+    type Short = Refs<STACK4>;
+    type Full = Refs<STACK4>;
+
+    #[inline(always)]
+    fn child(&self, k: usize) -> u32 {
+        self.child.get(k).copied().unwrap_or(EMPTY)
+    }
+
+    #[inline]
+    fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]) {
+        if k >= 4 || self.child[k] == EMPTY {
+            return ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        }
+        let lo = core::array::from_fn(|a| self.decode(a, self.lo[a][k]));
+        let hi = core::array::from_fn(|a| self.decode(a, self.hi[a][k]));
+        (lo, hi)
+    }
+
+    #[inline(always)]
+    fn test_one(&self, slab: &Slab, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+        if SIMD {
+            slab.test4(&self.rows4(), &self.child, t_min, t_max)
+        } else {
+            slab.test4_scalar(self, t_min, t_max)
+        }
+    }
+
+    #[inline(always)]
+    fn test_frustum(&self, f: &Frustum, t_lo: f32, t_hi: f32) -> (u32, [f32; WIDTH]) {
+        f.test(&self.rows(), t_lo, t_hi)
+    }
+
+    #[inline(always)]
+    fn test_lanes<L: Lane>(
+        &self,
+        slab: &PacketSlab<L>,
+        k: usize,
+        t_min: L,
+        t_max: L,
+        active: L::Mask,
+    ) -> (L::Mask, L) {
+        let (lo, hi) = self.bounds(k);
+        let mut b = [[f32::INFINITY; WIDTH]; 6];
+        for a in 0..3 {
+            b[a][0] = lo[a];
+            b[3 + a][0] = hi[a];
+        }
+        slab.test(&b, 0, t_min, t_max, active)
+    }
+}
+
+/// True where `wide`'s lanes are SIMD registers (x86-64, AArch64); elsewhere (Cortex-M,
+/// RISC-V 32) they are arrays in memory, and a loop over scalars is faster.
+pub(crate) const SIMD: bool = cfg!(any(target_feature = "sse2", target_feature = "neon"));
 
 /// The box widening relative to `R + |o|∞`: `2^-17` (see the [module docs](super) for why it
 /// is conservative).
@@ -207,6 +491,78 @@ impl Slab {
             .fast_min(plane(self.far[1], self.of[1], self.inv[1]))
             .fast_min(plane(self.far[2], self.of[2], self.inv[2]));
         (tn.simd_le(tf).to_bitmask(), tn.to_array())
+    }
+
+    /// [`test`](Self::test) for four children (rows of 4 lanes; slots 4 to 7 of the result
+    /// empty; the slots whose `child` is [`EMPTY`] never set): half the work and the stack of
+    /// 8 lanes where lanes are arrays (Cortex-M).
+    #[inline(always)]
+    pub fn test4(
+        &self,
+        b: &[f32x4; 6],
+        child: &[u32; 4],
+        t_min: f32,
+        t_max: f32,
+    ) -> (u32, [f32; WIDTH]) {
+        let mut out = [f32::INFINITY; WIDTH];
+        let mut used = 0;
+        for (k, &c) in child.iter().enumerate() {
+            used |= u32::from(c != EMPTY) << k;
+        }
+        if self.all {
+            out[..4].copy_from_slice(&[t_min; 4]);
+            return (used, out);
+        }
+        let plane = |p: usize, o: f32, inv: f32| (b[p] - f32x4::splat(o)) * inv;
+        let tn = f32x4::splat(t_min)
+            .fast_max(plane(self.near[0], self.on[0], self.inv[0]))
+            .fast_max(plane(self.near[1], self.on[1], self.inv[1]))
+            .fast_max(plane(self.near[2], self.on[2], self.inv[2]));
+        let tf = f32x4::splat(t_max)
+            .fast_min(plane(self.far[0], self.of[0], self.inv[0]))
+            .fast_min(plane(self.far[1], self.of[1], self.inv[1]))
+            .fast_min(plane(self.far[2], self.of[2], self.inv[2]));
+        out[..4].copy_from_slice(&tn.to_array());
+        (tn.simd_le(tf).to_bitmask() & used, out)
+    }
+
+    /// [`test4`](Self::test4) one child at a time in scalars, the same bits (where lanes
+    /// are arrays: a [`Node4`] on a microcontroller).
+    #[inline(always)]
+    fn test4_scalar(&self, n: &Node4, t_min: f32, t_max: f32) -> (u32, [f32; WIDTH]) {
+        let mut out = [f32::INFINITY; WIDTH];
+        let mut bits = 0;
+        let scale = n.exp.map(pow2);
+        for (k, &c) in n.child.iter().enumerate() {
+            if c == EMPTY {
+                continue;
+            }
+            if self.all {
+                bits |= 1 << k;
+                out[k] = t_min;
+                continue;
+            }
+            // `fast_max` and `fast_min` of the lanes: `if a < b { b } else { a }`, and so on.
+            let (mut tn, mut tf) = (t_min, t_max);
+            for (a, &s) in scale.iter().enumerate() {
+                let lo = n.origin[a] + f32::from(n.lo[a][k]) * s;
+                let hi = n.origin[a] + f32::from(n.hi[a][k]) * s;
+                let (near, far) = if self.near[a] == a {
+                    (lo, hi)
+                } else {
+                    (hi, lo)
+                };
+                let p = (near - self.on[a]) * self.inv[a];
+                tn = if tn < p { p } else { tn };
+                let p = (far - self.of[a]) * self.inv[a];
+                tf = if tf < p { tf } else { p };
+            }
+            if tn <= tf {
+                bits |= 1 << k;
+            }
+            out[k] = tn;
+        }
+        (bits, out)
     }
 }
 
@@ -378,4 +734,71 @@ pub(crate) fn highest<L: Lane>(t: L, valid: L::Mask) -> f32 {
         }
     }
     r
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The scalar node test (microcontrollers) gives the lanes' bits and entry parameters, on
+    /// random nodes (empty slots, tiny and huge quanta) and rays (axis-parallel, zero and
+    /// negative components, rays that visit every child).
+    #[test]
+    fn the_scalar_node_test_is_the_lanes() {
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = move || {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            s
+        };
+        let mut f = |scale: f32| ((next() >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * scale;
+        let mut entered = 0;
+        for case in 0..20_000 {
+            let mut n = Node4::EMPTY;
+            for a in 0..3 {
+                n.origin[a] = f(8.0);
+                n.exp[a] = [-20i8, -8, -3, 0, 4][case % 5];
+            }
+            for k in 0..4 {
+                if (case >> k) & 3 == 0 {
+                    continue;
+                }
+                n.child[k] = k as u32 + 1;
+                for a in 0..3 {
+                    let (x, y) = ((f(510.0) + 255.0) as u8, (f(510.0) + 255.0) as u8);
+                    n.lo[a][k] = x.min(y);
+                    n.hi[a][k] = x.max(y);
+                }
+            }
+            let pick = |x: f32, c: usize| match case / 7 % 4 {
+                0 if c == 1 => 0.0,
+                1 if c == 2 => -0.0,
+                _ => x,
+            };
+            let o = Vec3::new(f(20.0), f(20.0), f(20.0));
+            // Most rays aim at the node's first quanta, where its children are.
+            let q = 64.0 * pow2(n.exp[0]);
+            let at = Vec3::from_array(n.origin) + Vec3::new(f(q) + q, f(q) + q, f(q) + q);
+            let d = if case % 3 == 0 {
+                Vec3::new(f(2.0), f(2.0), f(2.0))
+            } else {
+                at - o
+            };
+            let d = Vec3::new(pick(d.x, 0), pick(d.y, 1), pick(d.z, 2));
+            let reach = if case % 97 == 0 { 1e31 } else { 40.0 };
+            let slab = Slab::new(o, d, reach);
+            let (t_min, t_max) = (f(1.0), 3.0 + f(4.0));
+            let (lanes, tn) = slab.test4(&n.rows4(), &n.child, t_min, t_max);
+            let (scalar, ts) = slab.test4_scalar(&n, t_min, t_max);
+            assert_eq!(lanes, scalar, "case {case}");
+            entered += lanes.count_ones();
+            for k in 0..4 {
+                if lanes & (1 << k) != 0 {
+                    assert_eq!(tn[k].to_bits(), ts[k].to_bits(), "case {case}, child {k}");
+                }
+            }
+        }
+        assert!(entered > 5_000, "too few children entered: {entered}");
+    }
 }

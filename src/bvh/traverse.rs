@@ -10,71 +10,32 @@
 //! hit found is still a candidate, and `any` had found nothing), except for collectors that
 //! report every hit, which start with the full stack.
 
-use super::node::{Frustum, Layout, PacketSlab, Slab, highest};
-use super::{EMPTY, LEAF, STACK, WIDTH};
+use super::node::{Entries, Frustum, Layout, PacketSlab, Slab, highest};
+use super::{EMPTY, LEAF, WIDTH};
 use crate::hit::Collector;
 use crate::lane::{Lane, Mask, Scalar};
 use crate::ray::{Ray, RayPacket};
 
-/// Entries of the short stack a traversal tries first (one that would overflow it runs again
-/// with the full [`STACK`]: initialising 2 KB per ray cost about a fifth of a primary ray's
-/// time).
-const SHORT: usize = 32;
-
-/// The traversal stack: node references with the entry parameter of their box. With
-/// `N < STACK` a push may not fit: the stack then records the overflow.
-struct Stack<const N: usize> {
-    node: [u32; N],
-    tn: [f32; N],
-    len: usize,
-    /// An entry was dropped: the answer is incomplete.
-    overflow: bool,
-}
-
-impl<const N: usize> Stack<N> {
-    #[inline(always)]
-    fn new() -> Self {
-        Stack {
-            node: [0; N],
-            tn: [0.0; N],
-            len: 0,
-            overflow: false,
+/// Pushes the children of `n` in `bits` farthest first (so the nearest is popped first).
+#[inline(always)]
+fn push_sorted<N: Layout, S: Entries>(stack: &mut S, n: &N, mut bits: u32, tn: &[f32; WIDTH]) {
+    let mut list = [(0u32, 0.0f32); WIDTH];
+    let mut m = 0;
+    while bits != 0 {
+        let k = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let item = (n.child(k), tn[k]);
+        // Insertion sort, descending entry parameter.
+        let mut j = m;
+        while j > 0 && list[j - 1].1 < item.1 {
+            list[j] = list[j - 1];
+            j -= 1;
         }
+        list[j] = item;
+        m += 1;
     }
-
-    #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, f32)> {
-        self.len = self.len.checked_sub(1)?;
-        Some((*self.node.get(self.len)?, *self.tn.get(self.len)?))
-    }
-
-    /// Pushes the children in `bits` farthest first (so the nearest is popped first).
-    #[inline(always)]
-    fn push_sorted<N2: Layout>(&mut self, n: &N2, mut bits: u32, tn: &[f32; WIDTH]) {
-        let mut list = [(0u32, 0.0f32); WIDTH];
-        let mut m = 0;
-        while bits != 0 {
-            let k = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            let item = (n.child(k), tn[k]);
-            // Insertion sort, descending entry parameter.
-            let mut j = m;
-            while j > 0 && list[j - 1].1 < item.1 {
-                list[j] = list[j - 1];
-                j -= 1;
-            }
-            list[j] = item;
-            m += 1;
-        }
-        for &(c, t) in &list[..m] {
-            if let (Some(a), Some(b)) = (self.node.get_mut(self.len), self.tn.get_mut(self.len)) {
-                *a = c;
-                *b = t;
-                self.len += 1;
-            } else {
-                self.overflow = true;
-            }
-        }
+    for &(c, t) in &list[..m] {
+        stack.push(c, t);
     }
 }
 
@@ -90,17 +51,18 @@ pub(crate) fn one<N: Layout, C: Collector<f32>>(
     mut leaf: impl FnMut(u32, &mut C) -> bool,
 ) -> bool {
     if !C::EVERY
-        && let Some(stop) = one_with::<SHORT, N, C>(nodes, reach, ray, c, &mut leaf)
+        && size_of::<N::Short>() < size_of::<N::Full>()
+        && let Some(stop) = one_with::<N::Short, N, C>(nodes, reach, ray, c, &mut leaf)
     {
         return stop;
     }
-    one_with::<STACK, N, C>(nodes, reach, ray, c, &mut leaf).unwrap_or(false)
+    one_with::<N::Full, N, C>(nodes, reach, ray, c, &mut leaf).unwrap_or(false)
 }
 
-/// [`one`] with a stack of `S` entries: `None` when it overflowed (never with `S = STACK`, by
-/// the depth bound).
+/// [`one`] with the stack `S`: `None` when it overflowed (never with the layout's full stack,
+/// by the depth bound).
 #[inline(always)]
-fn one_with<const S: usize, N: Layout, C: Collector<f32>>(
+fn one_with<S: Entries, N: Layout, C: Collector<f32>>(
     nodes: &[N],
     reach: f32,
     ray: &Ray,
@@ -120,8 +82,8 @@ fn one_with<const S: usize, N: Layout, C: Collector<f32>>(
     if bits == 0 {
         return Some(false);
     }
-    let mut stack = Stack::<S>::new();
-    stack.push_sorted(root, bits, &tn);
+    let mut stack = S::new();
+    push_sorted(&mut stack, root, bits, &tn);
     while let Some((r, tn)) = stack.pop() {
         if C::SHRINKS && tn > c.t_max() {
             continue;
@@ -129,7 +91,7 @@ fn one_with<const S: usize, N: Layout, C: Collector<f32>>(
         if r & LEAF == 0 {
             if let Some(n) = nodes.get(r as usize) {
                 let (bits, tn) = n.test_one(&slab, ray.t_min(), c.t_max());
-                stack.push_sorted(n, bits, &tn);
+                push_sorted(&mut stack, n, bits, &tn);
             }
             continue;
         }
@@ -137,7 +99,7 @@ fn one_with<const S: usize, N: Layout, C: Collector<f32>>(
             return Some(true);
         }
     }
-    (!stack.overflow).then_some(false)
+    (!stack.overflowed()).then_some(false)
 }
 
 /// A packet through the tree `nodes` (as [`one`]): `leaf(i, rays, c)` for every leaf `i` some
@@ -151,16 +113,17 @@ pub(crate) fn many<N: Layout, L: Lane, C: Collector<L>>(
     mut leaf: impl FnMut(u32, &RayPacket<L>, &mut C) -> bool,
 ) -> bool {
     if !C::EVERY
-        && let Some(stop) = many_with::<SHORT, N, L, C>(nodes, reach, rays, c, &mut leaf)
+        && size_of::<N::Short>() < size_of::<N::Full>()
+        && let Some(stop) = many_with::<N::Short, N, L, C>(nodes, reach, rays, c, &mut leaf)
     {
         return stop;
     }
-    many_with::<STACK, N, L, C>(nodes, reach, rays, c, &mut leaf).unwrap_or(false)
+    many_with::<N::Full, N, L, C>(nodes, reach, rays, c, &mut leaf).unwrap_or(false)
 }
 
-/// [`many`] with a stack of `S` entries: `None` when it overflowed.
+/// [`many`] with the stack `S`: `None` when it overflowed.
 #[inline(always)]
-fn many_with<const S: usize, N: Layout, L: Lane, C: Collector<L>>(
+fn many_with<S: Entries, N: Layout, L: Lane, C: Collector<L>>(
     nodes: &[N],
     reach: f32,
     rays: &RayPacket<L>,
@@ -178,7 +141,7 @@ fn many_with<const S: usize, N: Layout, L: Lane, C: Collector<L>>(
         ..*rays
     };
     let mut fr = frustum(&slab, &r, valid);
-    let mut stack = Stack::<S>::new();
+    let mut stack = S::new();
     if let Some(root) = nodes.first() {
         visit(&mut stack, root, &slab, &r, valid, fr.as_ref());
     }
@@ -202,7 +165,7 @@ fn many_with<const S: usize, N: Layout, L: Lane, C: Collector<L>>(
             }
         }
     }
-    (!stack.overflow).then_some(false)
+    (!stack.overflowed()).then_some(false)
 }
 
 /// A packet's [`Frustum`] with its lanes' lowest `t_min` and highest `t_max`.
@@ -227,8 +190,8 @@ fn frustum<L: Lane>(
 /// once (`t_lo`, `t_hi`: the lanes' lowest `t_min` and highest `t_max`), and a leaf child only
 /// if some lane's own test enters it.
 #[inline(always)]
-fn visit<N: Layout, L: Lane, const S: usize>(
-    stack: &mut Stack<S>,
+fn visit<N: Layout, L: Lane, S: Entries>(
+    stack: &mut S,
     n: &N,
     slab: &PacketSlab<L>,
     r: &RayPacket<L>,
@@ -248,7 +211,7 @@ fn visit<N: Layout, L: Lane, const S: usize>(
                 }
             }
         }
-        stack.push_sorted(n, bits, &tn);
+        push_sorted(stack, n, bits, &tn);
         return;
     }
     let mut bits = 0u32;
@@ -264,5 +227,5 @@ fn visit<N: Layout, L: Lane, const S: usize>(
             *key = tn.lane(mb.trailing_zeros() as usize).to_f64() as f32;
         }
     }
-    stack.push_sorted(n, bits, &key);
+    push_sorted(stack, n, bits, &key);
 }

@@ -70,6 +70,93 @@ macro_rules! panic_exits {
     };
 }
 
+/// The word [`paint_stack`] fills free RAM with.
+const PAINT: u32 = 0x5A5A_A5A5;
+
+unsafe extern "C" {
+    /// The end of `.bss` (cortex-m-rt and riscv-rt): the stack may grow down to here.
+    static __sheap: u32;
+    /// The top of the stack.
+    static _stack_start: u32;
+}
+
+/// The stack pointer.
+#[inline(always)]
+pub fn stack_pointer() -> usize {
+    let sp: usize;
+    // SAFETY: reads a register; no memory access.
+    #[cfg(target_arch = "arm")]
+    unsafe {
+        core::arch::asm!("mov {}, sp", out(reg) sp, options(nomem, nostack, preserves_flags))
+    };
+    // SAFETY: as above.
+    #[cfg(target_arch = "riscv32")]
+    unsafe {
+        core::arch::asm!("mv {}, sp", out(reg) sp, options(nomem, nostack, preserves_flags))
+    };
+    sp
+}
+
+/// Stack painting, for a measured peak: fills the free RAM between the end of `.bss` and
+/// 64 bytes below the current stack pointer with a pattern; [`stack_touched`] then finds the
+/// lowest word anything wrote.
+#[inline(never)]
+pub fn paint_stack() {
+    let lo = addr_of!(__sheap) as usize;
+    let hi = stack_pointer().saturating_sub(64) & !3;
+    let mut p = lo;
+    while p < hi {
+        // SAFETY: free RAM between the end of .bss and the live stack (4-byte aligned words).
+        unsafe { write_volatile(p as *mut u32, PAINT) };
+        p += 4;
+    }
+}
+
+/// The lowest address written since [`paint_stack`] (the deepest the stack grew).
+#[inline(never)]
+pub fn stack_touched() -> usize {
+    let lo = addr_of!(__sheap) as usize;
+    let top = addr_of!(_stack_start) as usize;
+    let mut p = lo;
+    // SAFETY: reads the RAM that paint_stack painted.
+    while p < top && unsafe { read_volatile(p as *const u32) } == PAINT {
+        p += 4;
+    }
+    p
+}
+
+/// The stack below its top at `_stack_start` the program has used since [`paint_stack`].
+pub fn peak_stack() -> usize {
+    (addr_of!(_stack_start) as usize).saturating_sub(stack_touched())
+}
+
+/// A host file opened for writing through semihosting (`path` NUL-terminated), or `None`.
+pub fn create(path: &str) -> Option<isize> {
+    // SAFETY: semihosting calls with a valid NUL-terminated name; QEMU runs with semihosting
+    // enabled (see .cargo/config.toml).
+    let fd = unsafe {
+        semihosting::syscall!(
+            OPEN,
+            path.as_ptr(),
+            semihosting::nr::open::W_TRUNC_BINARY,
+            path.len() - 1
+        )
+    } as isize;
+    (fd != -1).then_some(fd)
+}
+
+/// Writes `bytes` to the host file `fd`; true when all were written.
+pub fn write(fd: isize, bytes: &[u8]) -> bool {
+    // SAFETY: a valid buffer of `bytes.len()` bytes and a handle from `create`.
+    unsafe { semihosting::syscall!(WRITE, fd, bytes.as_ptr(), bytes.len()) == 0 }
+}
+
+/// Closes the host file `fd`; true on success.
+pub fn close(fd: isize) -> bool {
+    // SAFETY: a handle from `create`.
+    unsafe { semihosting::syscall!(CLOSE, fd) == 0 }
+}
+
 /// One vector file's cases, encoded by `build.rs` (parsed there by raylane's own parser): per
 /// case, little-endian, the kind (u8: 0 sphere, 1 plane, 2 triangle), the number of expected
 /// values (u8), the line (u16), the kind's inputs and the expected values (f32 bits each).

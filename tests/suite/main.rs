@@ -28,6 +28,7 @@ mod sets {
 }
 
 mod bvh {
+    pub mod baked_trees;
     pub mod equals_brute_force;
 }
 

@@ -1,7 +1,8 @@
-//! The vendored Stanford bunny (`tests/data/bunny.bin`, 3,674 triangles) through the BVH
-//! ([`raylane::bvh`]): loading, camera and a primary-ray render shared by the host's `render`
-//! example (`--scene bunny-fw`) and the firmware `targets/src/bin/bvh.rs`, which compares the
-//! two byte for byte at every packet width (`scripts/test.sh`).
+//! The vendored Stanford bunny (`tests/data/bunny.bin`, 3,674 triangles) through a BVH
+//! ([`raylane::bvh`]): loading, camera and a primary-ray render, row by row, shared by the
+//! host's `render` example (`--scene bunny-fw`, a tree built in RAM) and the firmware
+//! `targets/src/bin/bvh.rs` (the tree baked on the host, traced from flash), which
+//! `scripts/test.sh` compares byte for byte at every packet width.
 //!
 //! Shading uses `+ − × ÷ √` and compares only, as the other demo scenes: Lambert's law under
 //! one directional light with an ambient term, by the hit's geometric normal (facing the eye),
@@ -10,7 +11,6 @@
 use glam::Vec3;
 
 use super::shade::to_rgb;
-use raylane::bvh::TriangleBvh;
 use raylane::camera::Pinhole;
 use raylane::lane::Lane;
 use raylane::query::Query;
@@ -55,6 +55,12 @@ pub fn load(bin: &[u8], out: &mut [Triangle]) -> Option<usize> {
 /// right, at 2.2 bounding radii from the centre of the triangles' bounding box.
 #[must_use]
 pub fn camera(tris: &[Triangle], width: u32, height: u32) -> Pinhole {
+    camera_of(tris.iter().copied(), width, height)
+}
+
+/// [`camera`] for the triangles of any iterator (a baked tree's, on the device).
+#[must_use]
+pub fn camera_of(tris: impl Iterator<Item = Triangle>, width: u32, height: u32) -> Pinhole {
     let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
     for t in tris {
         for p in [t.a(), t.b(), t.c()] {
@@ -80,27 +86,42 @@ pub fn camera(tris: &[Triangle], width: u32, height: u32) -> Pinhole {
     )
 }
 
-/// Renders every primary ray of `cam` through `tree`, `L` rays per packet, into `rgb` (RGB8,
-/// row-major, `3 · width · height` bytes); returns the number of rays that hit, or `None`
-/// when `rgb` has the wrong length.
-pub fn render<L: Lane<Scalar = f32>>(
-    tree: &TriangleBvh,
+/// The most pixels a row has.
+pub const MAX_WIDTH: usize = 256;
+
+/// Renders every primary ray of `cam` through `tree` (any set: a tree in RAM, a baked tree in
+/// flash), `L` rays per packet (one lane: one [`Ray`](raylane::Ray) at a time), one row at a time: `row(y, rgb)` gets row `y` as RGB8 (so the
+/// device needs no image buffer); returns the number of rays that hit, or `None` for rows
+/// wider than [`MAX_WIDTH`].
+pub fn render_rows<L: Lane<Scalar = f32>, Q: Query + ?Sized>(
+    tree: &Q,
     cam: &Pinhole,
-    rgb: &mut [u8],
+    mut row: impl FnMut(u32, &[u8]),
 ) -> Option<u32> {
-    let (w, h) = (cam.width as usize, cam.height as usize);
-    if rgb.len() != 3 * w * h {
+    let w = cam.width as usize;
+    if w > MAX_WIDTH {
         return None;
     }
     let light = Vec3::new(-1.0, 2.0, 1.5).normalize();
     let mut hits = 0;
+    let mut rgb = [0u8; 3 * MAX_WIDTH];
     for y in 0..cam.height {
         let s = y as f32 / cam.height as f32;
         let sky = [0.16, 0.2, 0.28].map(|c| c * (1.0 - 0.5 * s));
         for x in (0..cam.width).step_by(L::LANES) {
-            let found = tree.closest(&cam.row_packet::<L>(x, y));
+            // One lane: the one-ray query (`closest(&Ray)`, what firmware calls); wider: the
+            // packet query. The same answers, bit for bit.
+            let found = (L::LANES > 1).then(|| tree.closest(&cam.row_packet::<L>(x, y)));
+            let one = match found {
+                None => tree.closest(&cam.row_packet::<f32>(x, y).ray(0)),
+                Some(_) => None,
+            };
             for i in 0..L::LANES.min((cam.width - x) as usize) {
-                let c = match found.lane(i) {
+                let hit = match &found {
+                    Some(f) => f.lane(i),
+                    None => one,
+                };
+                let c = match hit {
                     Some(hit) => {
                         hits += 1;
                         let k = 0.15 + 0.85 * hit.normal.dot(light).max(0.0);
@@ -108,10 +129,32 @@ pub fn render<L: Lane<Scalar = f32>>(
                     }
                     None => sky,
                 };
-                let at = 3 * (y as usize * w + x as usize + i);
-                rgb[at..at + 3].copy_from_slice(&to_rgb(c));
+                let at = 3 * (x as usize + i);
+                if let Some(px) = rgb.get_mut(at..at + 3) {
+                    px.copy_from_slice(&to_rgb(c));
+                }
             }
         }
+        row(y, &rgb[..3 * w]);
     }
     Some(hits)
+}
+
+/// [`render_rows`] into `rgb` (RGB8, row-major, `3 · width · height` bytes); `None` when
+/// `rgb` has the wrong length.
+pub fn render<L: Lane<Scalar = f32>, Q: Query + ?Sized>(
+    tree: &Q,
+    cam: &Pinhole,
+    rgb: &mut [u8],
+) -> Option<u32> {
+    let (w, h) = (cam.width as usize, cam.height as usize);
+    if rgb.len() != 3 * w * h {
+        return None;
+    }
+    render_rows::<L, Q>(tree, cam, |y, row| {
+        let at = 3 * w * y as usize;
+        if let Some(out) = rgb.get_mut(at..at + row.len()) {
+            out.copy_from_slice(row);
+        }
+    })
 }

@@ -65,28 +65,44 @@ pub enum SetupError {
     NotSphereKernel,
 }
 
-/// One mesh part, ready to render.
+/// One mesh part, ready to render: the mesh, or its focal cache (which holds the mesh).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Piece<'a> {
-    pub(super) mesh: Mesh<'a>,
-    pub(super) focal: Option<FocalMesh<'a>>,
+    pub(super) surface: Surface<'a>,
     pub(super) paint: Paint,
     pub(super) cull: Cull,
+}
+
+/// A part's triangles: the mesh alone (orthographic frames) or with its focal cache.
+#[derive(Clone, Copy, Debug)]
+pub(super) enum Surface<'a> {
+    Plain(Mesh<'a>),
+    Focal(FocalMesh<'a>),
+}
+
+impl<'a> Piece<'a> {
+    /// The part's mesh.
+    pub(super) fn mesh(&self) -> &Mesh<'a> {
+        match &self.surface {
+            Surface::Plain(m) => m,
+            Surface::Focal(f) => f.mesh(),
+        }
+    }
 }
 
 /// A scene seen by one camera with one sphere kernel, its caches built (see the
 /// [module docs](super)). Shared by reference between the threads that render its tiles.
 #[derive(Clone, Copy, Debug)]
-pub struct Frame<'a> {
+pub struct Frame<'a, const P: usize = MAX_PARTS> {
     pub(super) scene: Scene<'a>,
     pub(super) camera: Camera,
     pub(super) kernel: Kernel,
     pub(super) spheres: &'a [FocalSphere<f32>],
     pub(super) planes: &'a [FocalPlane],
-    pub(super) pieces: [Option<Piece<'a>>; MAX_PARTS],
+    pub(super) pieces: [Option<Piece<'a>>; P],
 }
 
-impl<'a> Frame<'a> {
+impl<'a, const P: usize> Frame<'a, P> {
     /// Sets up `scene` for `camera` and the sphere kernel `kernel` (one of
     /// [`sphere_kernels`](super::sphere_kernels)): builds the focal caches in `storage` (pinhole
     /// cameras) and each part's bounding sphere.
@@ -99,7 +115,7 @@ impl<'a> Frame<'a> {
         if kernel.prim() != Prim::Sphere {
             return Err(SetupError::NotSphereKernel);
         }
-        if scene.parts.len() > MAX_PARTS {
+        if scene.parts.len() > P {
             return Err(SetupError::TooManyParts);
         }
         let eye = match camera {
@@ -182,12 +198,12 @@ fn focus_planes<'a>(
 
 /// Every part of `scene` as a bounded mesh and, for rays from `eye`, its triangle caches (taken
 /// from `store` in part order).
-fn pieces<'a>(
+fn pieces<'a, const P: usize>(
     scene: &Scene<'a>,
     eye: Option<Vec3>,
     mut store: &'a mut [FocalTriangle<f32>],
-) -> Result<[Option<Piece<'a>>; MAX_PARTS], SetupError> {
-    let mut pieces = [None; MAX_PARTS];
+) -> Result<[Option<Piece<'a>>; P], SetupError> {
+    let mut pieces = [None; P];
     for (slot, part) in pieces.iter_mut().zip(scene.parts) {
         let (first, n) = (part.first as usize, part.count as usize);
         let indices = scene
@@ -195,19 +211,20 @@ fn pieces<'a>(
             .get(first..first.saturating_add(n))
             .ok_or(SetupError::BadPart)?;
         let mesh = Mesh::bounded(scene.positions, indices);
-        let focal = match eye {
+        let surface = match eye {
             Some(e) => {
                 let (head, rest) = core::mem::take(&mut store)
                     .split_at_mut_checked(n)
                     .ok_or(SetupError::TriangleStorage)?;
                 store = rest;
-                Some(FocalMesh::new(&mesh, e, head).map_err(|_| SetupError::TriangleStorage)?)
+                Surface::Focal(
+                    FocalMesh::new(&mesh, e, head).map_err(|_| SetupError::TriangleStorage)?,
+                )
             }
-            None => None,
+            None => Surface::Plain(mesh),
         };
         *slot = Some(Piece {
-            mesh,
-            focal,
+            surface,
             paint: part.paint,
             cull: part.cull,
         });

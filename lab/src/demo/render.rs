@@ -1,6 +1,7 @@
 //! The tile loop and the closest hit of each lane over every kind of primitive.
 
 use super::empty_sphere;
+use super::frame::Surface;
 use super::{Camera, Frame, ID_NONE, ID_PLANE, ID_SPHERE, ID_TRIANGLE, Stats, Tile};
 use crate::registry::{Kernel, Visitor};
 use raylane::Cull;
@@ -72,7 +73,7 @@ fn count<L: Lane>(rays: &RayPacket<L>) -> u64 {
     u64::from(rays.valid().bits().count_ones())
 }
 
-impl Frame<'_> {
+impl<const P: usize> Frame<'_, P> {
     /// Renders the whole image into `rgb` (`3·width·height` bytes) and, if given, `ids`
     /// (`width·height` bytes).
     pub fn render<L: Lane<Scalar = f32>>(&self, rgb: &mut [u8], ids: Option<&mut [u8]>) -> Stats {
@@ -172,19 +173,19 @@ impl Frame<'_> {
         let fr = matches!(self.camera, Camera::Pinhole(_)).then(|| FocalRays::new(r));
         for (p, piece) in self.pieces.iter().enumerate() {
             let Some(piece) = piece else { break };
-            let tris = k * piece.mesh.len() as u64;
+            let tris = k * piece.mesh().len() as u64;
             stats.bound_tests += k;
-            let keep = match (&fr, &piece.focal) {
-                (Some(fr), Some(fm)) => fm.may_hit(fr) & r.valid(),
-                _ => piece.mesh.may_hit(r) & r.valid(),
+            let keep = match (&fr, &piece.surface) {
+                (Some(fr), Surface::Focal(fm)) => fm.may_hit(fr) & r.valid(),
+                _ => piece.mesh().may_hit(r) & r.valid(),
             };
             if keep.none() {
                 stats.triangle_tests_saved += tris;
                 continue;
             }
-            let h = match &piece.focal {
-                Some(fm) if fr.is_some() => closest_in(&fm.culled(piece.cull), r),
-                _ => closest_triangles::<L>(&piece.mesh, r, piece.cull),
+            let h = match &piece.surface {
+                Surface::Focal(fm) if fr.is_some() => closest_in(&fm.culled(piece.cull), r),
+                _ => closest_triangles::<L>(piece.mesh(), r, piece.cull),
             };
             stats.triangle_tests += tris;
             best.merge(&h, ID_TRIANGLE, p as u8);
@@ -223,12 +224,12 @@ impl Frame<'_> {
 }
 
 /// The frame's sphere kernel over a packet, with its type: the closest sphere hit.
-struct SphereHits<'f, 'a, L: Lane> {
-    frame: &'f Frame<'a>,
+struct SphereHits<'f, 'a, L: Lane, const P: usize> {
+    frame: &'f Frame<'a, P>,
     rays: &'f RayPacket<L>,
 }
 
-impl<L: Lane<Scalar = f32>> Visitor for SphereHits<'_, '_, L> {
+impl<L: Lane<Scalar = f32>, const P: usize> Visitor for SphereHits<'_, '_, L, P> {
     type Output = Winners<L>;
 
     fn sphere<K: SphereKernel>(self, _: Kernel) -> Winners<L> {

@@ -9,7 +9,7 @@ use super::{Frame, ID_PLANE, ID_SPHERE, ID_TRIANGLE, Paint};
 use raylane::lane::sqrt_f32;
 use raylane::vec3::V3;
 
-impl Frame<'_> {
+impl<const P: usize> Frame<'_, P> {
     /// The colour of lane `i` (origin `o`, direction `d`), as RGB8.
     pub(super) fn shade(&self, o: Vec3, d: Vec3, best: &Best, i: usize) -> [u8; 3] {
         let (o, d) = (V3::<f32>::from(o), V3::<f32>::from(d));
@@ -35,7 +35,7 @@ impl Frame<'_> {
             }
             ID_TRIANGLE => {
                 let piece = self.pieces.get(best.part[i] as usize).copied().flatten();
-                let tri = piece.and_then(|pc| pc.mesh.triangle(best.index[i] as usize));
+                let tri = piece.and_then(|pc| pc.mesh().triangle(best.index[i] as usize));
                 let (Some(pc), Some(tri)) = (piece, tri) else {
                     return to_rgb(sky(d));
                 };

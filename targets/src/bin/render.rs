@@ -58,6 +58,7 @@ fn fail() -> ! {
 
 #[entry]
 fn main() -> ! {
+    raylane_fw::paint_stack();
     // The scene and its caches, in fixed-size arrays sized for scene 4.
     let mix = Mix::new();
     let mut spheres = [demo::empty_sphere(); Mix::SPHERES];
@@ -68,7 +69,7 @@ fn main() -> ! {
         planes: &mut planes,
         triangles: &mut triangles,
     };
-    let frame = match Frame::new(mix.scene(), Mix::camera(W, H), Kernel::Focal, storage) {
+    let frame = match Frame::<'_, 4>::new(mix.scene(), Mix::camera(W, H), Kernel::Focal, storage) {
         Ok(f) => f,
         Err(e) => {
             hprintln!("render mix ... cannot set up the frame ({:?})", e);
@@ -94,6 +95,7 @@ fn main() -> ! {
         hprintln!("render ... cannot write {}", PATH.trim_end_matches('\0'));
         fail();
     }
+    hprintln!("render stack: {} B (peak)", raylane_fw::peak_stack());
     hprintln!(
         "wrote {} ({} bytes)",
         PATH.trim_end_matches('\0'),

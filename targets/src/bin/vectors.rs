@@ -45,6 +45,7 @@ fn add(a: &mut Tally, b: Tally) {
 
 #[entry]
 fn main() -> ! {
+    raylane_fw::paint_stack();
     let mut digests = [[Digest::new(); WIDTHS]; METHODS];
     let mut totals = [[Tally::default(); WIDTHS]; METHODS];
     let mut cases = [Case::default(); CHUNK];
@@ -110,6 +111,7 @@ fn main() -> ! {
         }
     }
     opcounts();
+    hprintln!("vectors stack: {} B (peak)", raylane_fw::peak_stack());
     hprintln!("{} passed, {} failed", passed, failed);
     exit(ok && failed == 0)
 }
@@ -120,7 +122,7 @@ fn main() -> ! {
 /// 16 KB of RAM).
 #[inline(never)]
 fn opcounts() {
-    for r in raylane_lab::opcount::table().iter() {
+    raylane_lab::opcount::each_row(|r| {
         let c = r.counts;
         hprintln!(
             "opcount {},{},{},{},{},{},{}",
@@ -132,5 +134,5 @@ fn opcounts() {
             c.sqrt,
             c.cmp
         );
-    }
+    });
 }

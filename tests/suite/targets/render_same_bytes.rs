@@ -136,7 +136,7 @@ fn precision_sphere_pixels_per_method() {
         let cam = Precision::camera(size, size);
         let center = p.scene().spheres[0].center();
         for m in demo::sphere_kernels() {
-            let f = Frame::new(p.scene(), cam, m, Storage::none()).unwrap();
+            let f = <Frame>::new(p.scene(), cam, m, Storage::none()).unwrap();
             let (_, ids) = render(&f);
             let hits = ids.iter().filter(|&&i| i == ID_SPHERE).count();
             // Pixels whose exact answer is certain and differs from the picture.
@@ -291,7 +291,7 @@ fn icosphere_render_has_no_cracks() {
     let (width, height) = (160, 120);
     let cam = scenes::icosphere_camera(width, height);
     let mut store = Store::new(&scene);
-    let f = Frame::new(scene, cam, Kernel::Focal, store.storage()).unwrap();
+    let f = <Frame>::new(scene, cam, Kernel::Focal, store.storage()).unwrap();
     let (_, ids) = render_with::<f32x16>(&f);
     let (mut inside, mut cracks, mut stray) = (0, 0, 0);
     for y in 0..height {
@@ -322,7 +322,7 @@ fn icosphere_render_has_no_cracks() {
     // Every lane width gives the same picture (a smaller copy, to keep the test quick).
     let cam = scenes::icosphere_camera(48, 32);
     let mut store = Store::new(&scene);
-    render(&Frame::new(scene, cam, Kernel::Focal, store.storage()).unwrap());
+    render(&<Frame>::new(scene, cam, Kernel::Focal, store.storage()).unwrap());
 }
 
 #[test]
@@ -333,7 +333,7 @@ fn image_digests_are_pinned() {
     for d in Precision::DISTANCES {
         let p = Precision::new(d);
         for m in Precision::METHODS {
-            let f = Frame::new(p.scene(), Precision::camera(24, 24), m, Storage::none()).unwrap();
+            let f = <Frame>::new(p.scene(), Precision::camera(24, 24), m, Storage::none()).unwrap();
             bytes.extend(render(&f).0);
         }
     }
@@ -343,7 +343,7 @@ fn image_digests_are_pinned() {
     let mut bytes = Vec::new();
     for m in Ground::METHODS {
         let mut store = Store::new(&g.scene());
-        let f = Frame::new(g.scene(), Ground::camera(40, 30), m, store.storage()).unwrap();
+        let f = <Frame>::new(g.scene(), Ground::camera(40, 30), m, store.storage()).unwrap();
         bytes.extend(render(&f).0);
     }
     got.push(("ground 4 x 40x30", demo::fnv1a(&bytes)));
@@ -360,7 +360,7 @@ fn image_digests_are_pinned() {
         light: scenes::LIGHT,
     };
     let mut store = Store::new(&scene);
-    let f = Frame::new(
+    let f = <Frame>::new(
         scene,
         scenes::icosphere_camera(40, 30),
         Kernel::Focal,
@@ -372,7 +372,7 @@ fn image_digests_are_pinned() {
     let m = Mix::new();
     let (w, h) = Mix::FIRMWARE_SIZE;
     let mut store = Store::new(&m.scene());
-    let f = Frame::new(m.scene(), Mix::camera(w, h), Kernel::Focal, store.storage()).unwrap();
+    let f = <Frame>::new(m.scene(), Mix::camera(w, h), Kernel::Focal, store.storage()).unwrap();
     got.push(("mix 64x48", demo::fnv1a(&render(&f).0)));
     for (name, d) in &got {
         println!("{name:<22} {d:#018x}");
@@ -393,21 +393,21 @@ fn frames_refuse_short_storage_and_render_into_short_buffers() {
     let mut store = Store::new(&m.scene());
     store.triangles.truncate(Mix::TRIANGLES - 1);
     assert_eq!(
-        Frame::new(m.scene(), cam, Kernel::Focal, store.storage()).err(),
+        <Frame>::new(m.scene(), cam, Kernel::Focal, store.storage()).err(),
         Some(demo::SetupError::TriangleStorage)
     );
     let mut store = Store::new(&m.scene());
     store.spheres.clear();
     assert_eq!(
-        Frame::new(m.scene(), cam, Kernel::Focal, store.storage()).err(),
+        <Frame>::new(m.scene(), cam, Kernel::Focal, store.storage()).err(),
         Some(demo::SetupError::SphereStorage)
     );
     // Non-focal methods need no sphere entries.
-    let f = Frame::new(m.scene(), cam, Kernel::Robust, store.storage());
+    let f = <Frame>::new(m.scene(), cam, Kernel::Robust, store.storage());
     assert!(f.is_ok());
     // A buffer too short for the image: the whole pixels that fit are written, no panic.
     let mut store = Store::new(&m.scene());
-    let f = Frame::new(m.scene(), cam, Kernel::Focal, store.storage()).unwrap();
+    let f = <Frame>::new(m.scene(), cam, Kernel::Focal, store.storage()).unwrap();
     let mut short = vec![0u8; 3 * 16 * 8 - 5];
     let stats = f.render::<f32x8>(&mut short, None);
     assert_eq!(stats.rays, 16 * 8);
@@ -424,12 +424,15 @@ fn frames_refuse_short_storage_and_render_into_short_buffers() {
 }
 
 /// The firmware `bvh`'s picture (`raylane_lab::demo::bunny`, `targets/src/bin/bvh.rs`): the vendored
-/// bunny loads, its BVH builds in `bvh::needed` storage, and the 64×48 render gives the same
-/// bytes at every lane width, pinned by the digest the Cortex-M4F and M33 print.
+/// bunny loads, and the 64×48 render gives the same bytes at every lane width, through a tree
+/// built in RAM and through the tree baked for flash, pinned by the digest every board prints.
 #[test]
-fn bunny_fw_render_is_pinned_at_every_width() {
+fn bunny_fw_render_is_pinned_at_every_width_and_layout() {
+    use raylane::bvh::bake::{Baked, bake};
     use raylane::bvh::{self, Node, Packed, Scratch, Tri4};
+    use raylane::mesh::Mesh;
     use raylane::triangle::Triangle;
+    use raylane::{Pinhole, Query};
     use raylane_lab::demo::bunny;
     let bin = include_bytes!("../../data/bunny.bin");
     let mut tris = vec![Triangle::never(); bunny::TRIANGLES];
@@ -442,17 +445,31 @@ fn bunny_fw_render_is_pinned_at_every_width() {
     let mut scratch = vec![Scratch::default(); need.scratch];
     let tree =
         bvh::Bvh::build(&tris[..], &mut nodes[..], &mut leaves[..], &mut scratch[..]).unwrap();
+    let m = crate::sets::bunny_visible_surface::load_bin(bin);
+    let baked_bytes = bake(&Mesh::new(&m.pos, &m.idx)).unwrap();
+    let baked = Baked::open(&baked_bytes).unwrap();
     let (w, h) = bunny::SIZE;
     let cam = bunny::camera(&tris, w, h);
-    let image = |f: fn(&bvh::TriangleBvh, &raylane::Pinhole, &mut [u8]) -> Option<u32>| {
+    let from_baked = bunny::camera_of(
+        (0..baked.len()).filter_map(|i| baked.get(i)).map(|t| t.1),
+        w,
+        h,
+    );
+    assert_eq!(format!("{cam:?}"), format!("{from_baked:?}"));
+    fn image<L: raylane::Lane<Scalar = f32>, Q: Query + ?Sized>(q: &Q, cam: &Pinhole) -> Vec<u8> {
+        let (w, h) = (cam.width, cam.height);
         let mut rgb = vec![0u8; 3 * (w * h) as usize];
-        assert_eq!(f(&tree, &cam, &mut rgb), Some(979));
-        assert_eq!(f(&tree, &cam, &mut rgb[1..]), None);
+        assert_eq!(bunny::render::<L, Q>(q, cam, &mut rgb), Some(979));
+        assert_eq!(bunny::render::<L, Q>(q, cam, &mut rgb[1..]), None);
         rgb
-    };
-    let one = image(bunny::render::<f32>);
+    }
+    let one = image::<f32, _>(&tree, &cam);
     assert_eq!(demo::fnv1a(&one), 0xc4c0_3850_74ed_2589);
-    assert_eq!(image(bunny::render::<f32x4>), one);
-    assert_eq!(image(bunny::render::<f32x8>), one);
-    assert_eq!(image(bunny::render::<f32x16>), one);
+    assert_eq!(image::<f32x4, _>(&tree, &cam), one);
+    assert_eq!(image::<f32x8, _>(&tree, &cam), one);
+    assert_eq!(image::<f32x16, _>(&tree, &cam), one);
+    assert_eq!(image::<f32, _>(&baked, &cam), one);
+    assert_eq!(image::<f32x4, _>(&baked, &cam), one);
+    assert_eq!(image::<f32x8, _>(&baked, &cam), one);
+    assert_eq!(image::<f32x16, _>(&baked, &cam), one);
 }
