@@ -3,8 +3,9 @@
 //! allows), written once by [`bake`] (feature `alloc`, on the host) into a versioned,
 //! little-endian byte format that a microcontroller links as it is
 //! ([`include_baked!`](crate::include_baked)) and opens without copying ([`Baked::open`]): the
-//! bytes are checked once and then viewed in place, so a traversal needs no RAM beside its
-//! 512-byte stack.
+//! bytes are checked once and then viewed in place, so a query needs no RAM beside its stack:
+//! [`STACK4`] node references (196 bytes) and its frames, about 1 KB in all (measured by
+//! stack painting on the six QEMU boards: 996 B on rv32imafc to 1,236 B on the Cortex-M0).
 //!
 //! ```
 //! use raylane::bvh::bake::{Baked, bake};

@@ -30,6 +30,7 @@ mod sets {
 mod bvh {
     pub mod baked_trees;
     pub mod equals_brute_force;
+    pub mod from_parts_checked;
 }
 
 mod targets {

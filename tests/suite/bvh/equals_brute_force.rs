@@ -482,12 +482,12 @@ fn from_parts_rejects_broken_trees() {
     let mut rng = SmallRng::seed_from_u64(22);
     let tris = soup(&mut rng, 100);
     let (mut nodes, leaves) = owned(&tris[..]);
-    assert!(Bvh::from_parts(&nodes, &leaves).is_some());
-    assert!(Bvh::<Tri4>::from_parts(&[], &leaves).is_none());
+    assert!(Bvh::from_parts(&nodes, &leaves).is_ok());
+    assert!(Bvh::<Tri4>::from_parts(&[], &leaves).is_err());
     nodes[0].child[0] = 0; // a cycle
-    assert!(Bvh::from_parts(&nodes, &leaves).is_none());
+    assert!(Bvh::from_parts(&nodes, &leaves).is_err());
     nodes[0].child[0] = bvh::LEAF | 10_000;
-    assert!(Bvh::from_parts(&nodes, &leaves).is_none());
+    assert!(Bvh::from_parts(&nodes, &leaves).is_err());
     let _ = Sphere4::EMPTY;
 }
 
