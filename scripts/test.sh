@@ -28,7 +28,8 @@
 #    4-lane packets).
 # 10. The demo's scene 4 rendered by the firmware on five boards (scalar lane, written to the
 #    host through semihosting) equals the host's render at every packet width, byte for byte.
-# 11. A summary: every configuration with its digest, code size and run time.
+# 11. The README's firmware crate (examples/firmware) built and run on the Cortex-M4F and M0.
+# 12. A summary: every configuration with its digest, code size and run time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -295,6 +296,24 @@ done
 echo "firmware BVH images (${bvhs[*]}) equal to the host's at 1, 4, 8 and 16 lanes"
 echo "the baked bunny on each board (flash and RAM as linked and as measured by stack painting):"
 cat target/bvh/memory.md
+
+step "examples/firmware: the README's firmware crate, built and run on the Cortex-M4F and M0"
+# A crate to copy (its own workspace): build.rs bakes mesh.obj (raylane::bvh::bake), src/main.rs
+# links it with include_baked!, opens it with Baked::open and prints the closest hit through
+# semihosting. README.md quotes it (tests/suite/docs/readme_firmware.rs keeps the quotes true)
+# and says what it prints.
+cd "$root/examples/firmware"
+cargo fmt -- --check || fail "examples/firmware is not formatted"
+for t in thumbv7em-none-eabihf thumbv6m-none-eabi; do
+  cargo build --quiet --release --target "$t" || fail "examples/firmware does not build for $t"
+  status=0
+  out=$(timeout 120 cargo run --quiet --release --target "$t" 2>&1) || status=$?
+  [ "$status" -eq 0 ] || fail "examples/firmware exited with $status on $t: $out"
+  grep -qF "\`$out\`" "$root/README.md" || fail "examples/firmware printed '$out' on $t, not what README.md says"
+  text=$("$(tools "$t")-size" -A -d "target/$t/release/raylane-firmware-example" | awk '$1==".text"{print $2}')
+  echo "examples/firmware $t: $out (.text $text B)"
+done
+cd "$root"
 
 step "summary: every configuration, its digest, code size and digest run time"
 # The digest: the first 16 hex digits of the MD5 of the configuration's digest lines (the

@@ -41,4 +41,5 @@ mod docs {
     pub mod doc_op_counts;
     pub mod layers_hold;
     pub mod op_count_table;
+    pub mod readme_firmware;
 }
