@@ -32,6 +32,7 @@ use std::collections::BTreeMap;
 use std::time::Instant;
 
 use glam::Vec3;
+use raylane::bvh::bake::Baked;
 use raylane::bvh::{Bvh, Leaf};
 use raylane::{Ray, RayPacket};
 use raylane_bench::bvh_peers::{
@@ -225,6 +226,8 @@ fn normal(m: &MeshData, i: u32) -> Vec3 {
 
 /// raylane's BVH's name in the build table.
 const BVH: &str = "raylane BVH";
+/// The baked tree's name in the build table.
+const BAKED: &str = "raylane baked";
 
 /// Scenes above this many primitives are checked, and traced by raylane's brute force, on
 /// every [`STRIDE`]-th ray only (every ray otherwise).
@@ -316,7 +319,6 @@ fn bvh_jobs<'a, P: Leaf + 'static>(
     shadow: bool,
     all: &'a [Ray],
     t: &'a Bvh<'a, P>,
-    eye: Option<Vec3>,
     keep: &'a Keep,
 ) -> Vec<Job<'a>> {
     let b8: &Vec<RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(all));
@@ -367,6 +369,43 @@ fn bvh_jobs<'a, P: Leaf + 'static>(
     }
 }
 
+/// The mesh baked for flash, traced on the host: single rays and packets of 8.
+fn baked_jobs<'a>(shadow: bool, all: &'a [Ray], t: &'a Baked<'a>, keep: &'a Keep) -> Vec<Job<'a>> {
+    let b8: &Vec<RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(all));
+    let (n, every) = (all.len(), (all.len(), true));
+    if shadow {
+        vec![
+            job(
+                "raylane baked any x1",
+                every,
+                move || rl::bvh_any1(t, all, None),
+                move || collect(|o| rl::bvh_any1(t, all, o)),
+            ),
+            job(
+                "raylane baked any x8",
+                every,
+                move || rl::bvh_any(t, b8, n, None),
+                move || collect(|o| rl::bvh_any(t, b8, n, o)),
+            ),
+        ]
+    } else {
+        vec![
+            job(
+                "raylane baked x1",
+                every,
+                move || rl::bvh_closest1(t, all, None),
+                move || collect(|o| rl::bvh_closest1(t, all, o)),
+            ),
+            job(
+                "raylane baked x8",
+                every,
+                move || rl::bvh_closest(t, b8, n, None),
+                move || collect(|o| rl::bvh_closest(t, b8, n, o)),
+            ),
+        ]
+    }
+}
+
 /// Keeps the converted rays of a scene alive while its jobs borrow them.
 #[derive(Default)]
 struct Keep(RefCell<Vec<Box<dyn std::any::Any>>>);
@@ -404,7 +443,7 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
     // (the last build of each is used).
     let size = rl::part_size(n);
     let label_bf = "raylane brute force + spheres".to_string();
-    let mut times: [Vec<f64>; 5] = Default::default();
+    let mut times: [Vec<f64>; 6] = Default::default();
     let mut built = None;
     for _ in 0..runs {
         let start = Instant::now();
@@ -418,10 +457,12 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
         times[3].push(par.build.as_secs_f64());
         let tree = rl::Tree::mesh(&m.positions, &m.indices);
         times[4].push(tree.build.as_secs_f64());
-        built = Some((parts, ebr, obv, par, tree));
+        let baked = rl::BakedTree::mesh(&m.positions, &m.indices);
+        times[5].push(baked.as_ref().map_or(f64::NAN, |b| b.build.as_secs_f64()));
+        built = Some((parts, ebr, obv, par, tree, baked));
     }
-    let (parts, mut ebr, obv, par, tree) = built.expect("at least one run");
-    let [t_bf, t_e, t_o, t_p, t_t] = times.map(median);
+    let (parts, mut ebr, obv, par, tree, baked) = built.expect("at least one run");
+    let [t_bf, t_e, t_o, t_p, t_t, t_b] = times.map(median);
     let bounded = parts.meshes();
     let ids = parts.ids();
     let bf_bytes = (36 + 12 + 88) as f64 + 20.0 * parts.len() as f64 / n as f64;
@@ -432,10 +473,20 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
         ("obvhs".into(), (t_o, obv.bytes() as f64 / n as f64)),
         ("parry3d".into(), (t_p, f64::NAN)),
         (BVH.to_string(), (t_t, tree.bytes() as f64 / n as f64)),
+        (
+            BAKED.to_string(),
+            (
+                t_b,
+                baked
+                    .as_ref()
+                    .map_or(f64::NAN, |b| b.bytes() as f64 / n as f64),
+            ),
+        ),
     ] {
         res.builds.insert((name.clone(), c), v);
     }
     let tb = tree.bvh();
+    let opened = baked.as_ref().map(|b| b.open());
 
     // The secondary rays start from Embree's primary hits (checked below like every other
     // answer).
@@ -498,8 +549,10 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
                 move || collect(|o| rl::closest(s8, b, ids, ns, o)),
             ));
         }
-        let eye = (kind == Kind::Primary).then_some(w.cam.eye);
-        jobs.extend(bvh_jobs(shadow, all, &tb, eye, &keep));
+        jobs.extend(bvh_jobs(shadow, all, &tb, &keep));
+        if let Some(bk) = opened.as_ref() {
+            jobs.extend(baked_jobs(shadow, all, bk, &keep));
+        }
         if kind == Kind::Primary {
             // The focal parts over every primary ray, the cache built for the eye inside
             // every frame.
@@ -615,8 +668,7 @@ fn sphere_scene(res: &mut Results, count: usize, opts: &Opts) {
             move || rl::spheres_closest(p16, sp, ns, None),
             move || occluded(collect(|o| rl::spheres_closest(p16, sp, ns, o))),
         ));
-        let eye = (kind == Kind::Primary).then_some(w.cam.eye);
-        jobs.extend(bvh_jobs(shadow, all, &tb, eye, &keep));
+        jobs.extend(bvh_jobs(shadow, all, &tb, &keep));
         run_jobs(res, &name, kind, (&want, STRIDE), jobs, runs);
     }
 }
@@ -774,7 +826,7 @@ fn report(res: &Results) {
         ("raylane brute force + spheres", "raylane brute force"),
         ("raylane focal + spheres", "raylane focal"),
         ("raylane BVH", "raylane BVH"),
-        ("raylane BVH focal", "raylane BVH focal"),
+        ("raylane baked (flash layout)", "raylane baked"),
     ];
     let mut head = String::from("| scene | primitives |");
     let mut rule = String::from("| --- | ---: |");

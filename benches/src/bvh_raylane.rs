@@ -8,7 +8,9 @@
 //! * the reference tracer every contender is checked against: the same parts with the scalar
 //!   `Watertight` kernel (exact brute force, with each hit's triangle index);
 //! * raylane's BVH ([`Tree`], [`raylane::bvh`]): built from the indexed mesh or the spheres,
-//!   single rays (`closest`, `any`) and packets of 8 and 16 (`closest_packet`, `any_packet`).
+//!   single rays (`closest`, `any`) and packets of 8 and 16 (`closest_packet`, `any_packet`);
+//! * the same mesh baked for flash ([`BakedTree`], [`raylane::bvh::bake`]: 4-wide quantized
+//!   nodes over indexed triangles), traced on the host.
 //!
 //! Every function returns the number of rays hit and, when `out` is given, pushes one answer
 //! per ray (`(t, triangle)`; `(0, 0)` for an occluded shadow ray).
@@ -191,6 +193,48 @@ impl<P: Leaf> Tree<P> {
     /// Bytes of the nodes and leaves.
     pub fn bytes(&self) -> usize {
         size_of_val(&self.nodes[..]) + size_of_val(&self.leaves[..])
+    }
+}
+
+/// A mesh baked for flash ([`bvh::bake::bake`]), in 4-byte-aligned storage as
+/// `include_baked!` links it.
+pub struct BakedTree {
+    words: Vec<u32>,
+    len: usize,
+    /// Bake time (the build and the conversion).
+    pub build: Duration,
+}
+
+impl BakedTree {
+    /// Bakes an indexed mesh; `None` when it cannot be baked (too deep, too many triangles).
+    pub fn mesh(positions: &[Vec3], indices: &[[u32; 3]]) -> Option<Self> {
+        let start = Instant::now();
+        let bytes = bvh::bake::bake(&Mesh::new(positions, indices)).ok()?;
+        let build = start.elapsed();
+        let mut words = vec![0u32; bytes.len().div_ceil(4)];
+        for (w, c) in words.iter_mut().zip(bytes.chunks(4)) {
+            let mut b = [0u8; 4];
+            b[..c.len()].copy_from_slice(c);
+            *w = u32::from_le_bytes(b);
+        }
+        Some(BakedTree {
+            words,
+            len: bytes.len(),
+            build,
+        })
+    }
+
+    /// The tree, opened in place (checked).
+    pub fn open(&self) -> bvh::bake::Baked<'_> {
+        // SAFETY: u32 storage viewed as its bytes (any alignment is fine for u8), len ≤ 4·words.
+        let bytes =
+            unsafe { std::slice::from_raw_parts(self.words.as_ptr().cast::<u8>(), self.len) };
+        bvh::bake::Baked::open(bytes).expect("a tree bake made")
+    }
+
+    /// Bytes of the baked tree (nodes, triangles, ids, vertices).
+    pub fn bytes(&self) -> usize {
+        self.len
     }
 }
 
