@@ -4,9 +4,9 @@
 #   ./scripts/test.sh
 #
 # 1. Installs what it needs, idempotently: Debian packages (QEMU for Arm and RISC-V, the
-#    AArch64 cross linker, Arm and RISC-V binutils), rustup targets, and the MSRV toolchain
-#    (Cargo.toml's rust-version) with the minimal profile.
-# 2. Formatting, clippy over the workspace, rustdoc.
+#    AArch64 cross linker, Arm and RISC-V binutils, Embree for the peer benchmarks), rustup
+#    targets, and the MSRV toolchain (Cargo.toml's rust-version) with the minimal profile.
+# 2. Formatting, clippy over the workspace and over the benchmarks with their peers, rustdoc.
 # 3. The library builds for the host, AArch64, thumbv6m (Cortex-M0), thumbv7m (Cortex-M3),
 #    thumbv7em (M4F), thumbv8m.main (M33), riscv32imac and riscv32imafc, with no default
 #    features and with each feature.
@@ -27,7 +27,10 @@
 #    (rv32imafc) with no software sqrtf; code size per target (scalar kernels, and with
 #    4-lane packets).
 # 10. The demo's scene 4 rendered by the firmware on five boards (scalar lane, written to the
-#    host through semihosting) equals the host's render at every packet width, byte for byte.
+#    host through semihosting) equals the host's render at every packet width, byte for byte;
+#    the vendored bunny baked on the host (targets/build.rs) and traced from flash on all six
+#    boards, the Cortex-M0 included, equals the host's render at every width the board holds,
+#    with a table of each board's flash, RAM (stack painting) and largest mesh that fits.
 # 11. The README's firmware crate (examples/firmware) built and run on the Cortex-M4F and M0.
 # 12. A summary: every configuration with its digest, code size and run time.
 set -euo pipefail
@@ -46,6 +49,7 @@ command -v aarch64-linux-gnu-gcc >/dev/null || need+=(gcc-aarch64-linux-gnu)
 [ -e /usr/aarch64-linux-gnu/lib/crt1.o ] || need+=(libc6-dev-arm64-cross)
 command -v arm-none-eabi-objdump >/dev/null || need+=(binutils-arm-none-eabi)
 command -v riscv64-unknown-elf-objdump >/dev/null || need+=(binutils-riscv64-unknown-elf)
+[ -e /usr/include/embree3/rtcore.h ] || need+=(libembree-dev)
 if [ ${#need[@]} -gt 0 ]; then
   sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
   echo "installing: ${need[*]}"
@@ -64,6 +68,8 @@ step "format and lints"
 cargo fmt --all -- --check
 (cd targets && cargo fmt -- --check)
 cargo clippy --quiet --workspace --all-targets -- -D warnings
+# The benchmarks against the peers (Embree, obvhs, parry3d, bevy) compile and pass clippy too.
+cargo clippy --quiet -p raylane-bench --features peers --all-targets -- -D warnings
 RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p raylane -p raylane-lab
 
 step "library builds: host, AArch64 and every embedded target; the lab beside it"

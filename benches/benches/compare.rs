@@ -148,7 +148,7 @@ fn scene(c: &mut Criterion, prim: Prim, kind: Rays, n: usize) {
             all.push(raylane(Kernel::Watertight, Shape::Packets, &f, &l8));
             all.push(raylane(Kernel::Moller, Shape::Packets, &f, &l8));
             // The scene as a user would hold it: parts with bounding spheres.
-            meshes = raylane::focal::FocalMesh::new(&parts, f.cam.eye, &mut storage);
+            meshes = parts.focus(f.cam.eye, &mut storage);
             let (m, p8, p16) = (&meshes, &l8.packets, &l16.packets);
             let label =
                 |w: usize| format!("raylane triangle-focal x{w} + bounding spheres ({PART})");
