@@ -1,6 +1,6 @@
 //! Trees baked on a host and traced from flash: a triangle mesh's BVH in 4-wide quantized
 //! nodes ([`Node4`]) over indexed triangles (shared vertices, 16-bit indices where the mesh
-//! allows), written once by [`bake`] (feature `alloc`, on the host) into a versioned,
+//! allows), written once by `bake` (feature `alloc`, on the host) into a versioned,
 //! little-endian byte format that a microcontroller links as it is
 //! ([`include_baked!`](crate::include_baked)) and opens without copying ([`Baked::open`]): the
 //! bytes are checked once and then viewed in place, so a query needs no RAM beside its stack:
@@ -574,7 +574,7 @@ macro_rules! include_baked {
     }};
 }
 
-/// Why [`bake`] could not bake a mesh.
+/// Why `bake` (feature `alloc`) could not bake a mesh.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BakeError {
     /// More triangles or vertices than the format counts (`2^29`).
