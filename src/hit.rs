@@ -458,6 +458,67 @@ impl<L: Lane> Collector<L> for Any<L> {
     }
 }
 
+/// Lane `i` of a packet's collector as a one-ray collector: a packet lane continued as a
+/// single ray (the BVH's hybrid traversal). Its activity and `t_max` are the lane's, its
+/// candidates go to the lane (the same rule, so the same answer); it asks its traversal to
+/// stop when the lane is done. Not for collectors that report every hit.
+pub(crate) struct LaneOf<'c, L: Lane, C: Collector<L>> {
+    c: &'c mut C,
+    i: usize,
+    /// The lane's `t_max` and activity, kept: only this collector's offers change them.
+    t_max: f32,
+    active: bool,
+    _lane: core::marker::PhantomData<L>,
+}
+
+impl<'c, L: Lane, C: Collector<L>> LaneOf<'c, L, C> {
+    /// Lane `i` of `c`.
+    #[inline(always)]
+    pub(crate) fn new(c: &'c mut C, i: usize) -> Self {
+        LaneOf {
+            t_max: c.t_max().lane(i).to_f64() as f32,
+            active: c.active().test(i),
+            c,
+            i,
+            _lane: core::marker::PhantomData,
+        }
+    }
+}
+
+impl<L: Lane, C: Collector<L>> Collector<f32> for LaneOf<'_, L, C> {
+    const SHRINKS: bool = C::SHRINKS;
+
+    #[inline(always)]
+    fn active(&self) -> bool {
+        self.active
+    }
+
+    #[inline(always)]
+    fn t_max(&self) -> f32 {
+        self.t_max
+    }
+
+    #[inline(always)]
+    fn offer(
+        &mut self,
+        h: &LaneHit<f32>,
+        at: At,
+        _: impl FnOnce(&Winners<f32>) -> Hits<f32>,
+    ) -> bool {
+        let one = LaneHit {
+            t: L::from_f32(h.t),
+            u: L::from_f32(h.u),
+            v: L::from_f32(h.v),
+            w: L::from_f32(h.w),
+            mask: L::Mask::splat(false).with_lane(self.i, h.mask),
+        };
+        self.c.offer(&one, at, |_| Hits::miss());
+        self.t_max = self.c.t_max().lane(self.i).to_f64() as f32;
+        self.active = self.c.active().test(self.i);
+        !self.active
+    }
+}
+
 /// Every hit inside the interval, as records passed to a callback in the order the set
 /// visits them.
 pub struct All<L: Lane, F: FnMut(&Hits<L>)> {

@@ -196,6 +196,10 @@ pub trait Lane:
     type Indices: Copy + Debug + PartialEq + AsRef<[u32]> + AsMut<[u32]>;
     /// Number of lanes.
     const LANES: usize;
+    /// True for lanes of plain `f32` values (the scalar lane and `wide`'s vectors): a packet
+    /// of them may continue lane by lane through the one-ray traversal (the same answers).
+    /// False for counting and higher-precision lanes, whose work stays in the lane type.
+    const PLAIN_F32: bool = false;
 
     /// The same value in every lane.
     fn splat(x: Self::Scalar) -> Self;
@@ -308,6 +312,7 @@ fn arm_vsqrt(x: f32) -> f32 {
 }
 
 impl Lane for f32 {
+    const PLAIN_F32: bool = true;
     type Scalar = f32;
     type Mask = bool;
     type Precise = f64;
@@ -464,6 +469,7 @@ macro_rules! wide_lane {
             type Precise = f64;
             type Indices = [u32; $n];
             const LANES: usize = $n;
+            const PLAIN_F32: bool = true;
 
             #[inline(always)]
             fn splat(x: f32) -> Self {

@@ -12,7 +12,7 @@
 
 use glam::Vec3;
 
-use crate::lane::Lane;
+use crate::lane::{Lane, Scalar};
 use crate::vec3::V3;
 
 /// Largest `| |d|² − 1 |` a unit direction may have (`2^-20`): what [`Dir::new`] guarantees
@@ -281,6 +281,20 @@ impl<L: Lane> RayPacket<L> {
             dir: self.dir.lane(i),
             t_min: self.t_min.lane(i),
             t_max: self.t_max.lane(i),
+        }
+    }
+
+    /// Lane `i` as a scalar ray, its values rounded to `f32` (exact for [`Lane::PLAIN_F32`]
+    /// lanes, whose values are `f32`).
+    #[inline(always)]
+    pub(crate) fn lane_ray(&self, i: usize) -> Ray {
+        let f = |x: L| x.lane(i).to_f64() as f32;
+        let v = |p: &V3<L>| Vec3::new(f(p.x), f(p.y), f(p.z));
+        Ray {
+            origin: v(&self.origin),
+            dir: v(&self.dir),
+            t_min: f(self.t_min),
+            t_max: f(self.t_max),
         }
     }
 

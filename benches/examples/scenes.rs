@@ -498,18 +498,23 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
         .collect();
     let w = Workload::new(cam, &hits, centre, radius);
     let frac = e_hits.iter().filter(|h| h.is_some()).count() as f64 / primary.len() as f64;
-    res.scenes.push((
-        name.clone(),
-        n,
-        frac,
-        w.diffuse.len(),
-        w.shadow.len(),
-        if stride > 1 {
-            format!("parts of {size}; reference and brute force on every {stride}st ray")
-        } else {
-            format!("parts of {size}")
-        },
-    ));
+    res.scenes
+        .push((name.clone(), n, frac, w.diffuse.len(), w.shadow.len(), {
+            let st = tb.stats();
+            let fill = format!(
+                "BVH: {:.2} children per node, {:.2} triangles per leaf, depth {}",
+                st.children_per_node(),
+                st.primitives_per_leaf(),
+                st.depth
+            );
+            if stride > 1 {
+                format!(
+                    "parts of {size}; reference and brute force on every {stride}st ray; {fill}"
+                )
+            } else {
+                format!("parts of {size}; {fill}")
+            }
+        }));
     res.order.push((name.clone(), n));
 
     let keep = Keep::default();

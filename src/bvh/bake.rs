@@ -59,8 +59,8 @@ use glam::Vec3;
 use wide::f32x4;
 
 use super::node::{Layout, MAX_DEPTH4, Node4, SIMD, STACK4};
-use super::{EMPTY, LEAF, traverse};
-use crate::hit::{At, Collector, Hits, Record, Winners};
+use super::{EMPTY, LEAF, split, traverse};
+use crate::hit::{At, Collector, Hits, LaneOf, Record, Winners};
 use crate::kernel::{Cull, Kernel, LaneHit, admit};
 use crate::lane::{Lane, Mask};
 use crate::ray::{Ray, RayPacket, UNIT_TOLERANCE};
@@ -424,69 +424,24 @@ impl<'a> Baked<'a> {
     }
 }
 
-/// A baked tree answers as the mesh it was baked from, with the same kernel and culling, bit
-/// for bit; its hits carry the mesh's triangle indices.
-impl Set for Baked<'_> {
-    type Prim = Triangle;
-    type Kernel = Watertight;
-
-    #[inline]
-    fn trace_with<K: Kernel<Triangle>, L: Lane, C: Collector<L>>(
-        &self,
-        cull: Cull,
-        rays: &RayPacket<L>,
-        set: u32,
-        c: &mut C,
-    ) -> bool {
-        let rays = admit(rays, K::UNIT_DIRECTIONS);
-        let pre = K::prepare(&rays);
-        traverse::many(self.nodes, self.reach, &rays, c, |r_leaf, r, c| {
-            let (first, count) = Self::leaf(r_leaf);
-            let mut r = *r;
-            for t in first..first + count {
-                r.t_max = c.t_max();
-                let tri = self.triangle(t);
-                let at = At {
-                    set,
-                    index: self.id(t),
-                    loc: t as u32,
-                };
-                let record = |w: &Winners<L>| Triangle::records(&rays, w, cull, |_| Some(tri));
-                let p = TrianglePacket::splat(&tri);
-                let stop = if C::EVERY {
-                    K::each(&r, &pre, &p, cull, |h| c.offer(h, at, record))
-                } else {
-                    let h = K::first(&r, &pre, &p, cull);
-                    h.mask.any() && c.offer(&h, at, record)
-                };
-                if stop {
-                    return true;
-                }
-            }
-            false
-        })
-    }
-
-    #[inline]
-    fn trace_ray_with<K: Kernel<Triangle>, C: Collector<f32>>(
+impl Baked<'_> {
+    /// One ray from the node reference `start` (0: the root) into `c`: the one-ray query, and
+    /// the packets' lanes that continue alone.
+    #[inline(always)]
+    fn trace_from<K: Kernel<Triangle>, C: Collector<f32>>(
         &self,
         cull: Cull,
         ray: &Ray,
+        start: u32,
         set: u32,
         c: &mut C,
     ) -> bool {
-        if C::EVERY {
-            return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
-        }
-        if K::UNIT_DIRECTIONS && (ray.dir().length_squared() - 1.0).abs() > UNIT_TOLERANCE {
-            return false;
-        }
         if !SIMD {
             // Without SIMD lanes (Cortex-M, RISC-V 32) four triangles in lanes are four scalar
             // tests and more stack: one triangle at a time, the same bits.
             let r1 = RayPacket::<f32>::splat(ray);
             let mut pre = None;
-            return traverse::one(self.nodes, self.reach, ray, c, |r_leaf, c| {
+            return traverse::one(self.nodes, self.reach, ray, start, c, |r_leaf, c| {
                 let (first, count) = Self::leaf(r_leaf);
                 let pre = pre.get_or_insert_with(|| K::prepare(&r1));
                 for t in first..first + count {
@@ -510,6 +465,7 @@ impl Set for Baked<'_> {
             self.nodes,
             self.reach,
             ray,
+            start,
             c,
             #[inline(always)]
             |r_leaf, c| {
@@ -545,6 +501,84 @@ impl Set for Baked<'_> {
                 false
             },
         )
+    }
+}
+
+/// A baked tree answers as the mesh it was baked from, with the same kernel and culling, bit
+/// for bit; its hits carry the mesh's triangle indices.
+impl Set for Baked<'_> {
+    type Prim = Triangle;
+    type Kernel = Watertight;
+
+    #[inline]
+    fn trace_with<K: Kernel<Triangle>, L: Lane, C: Collector<L>>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        let rays = admit(rays, K::UNIT_DIRECTIONS);
+        let pre = K::prepare(&rays);
+        traverse::many(
+            self.nodes,
+            self.reach,
+            &rays,
+            c,
+            |r_leaf, r, c| {
+                let (first, count) = Self::leaf(r_leaf);
+                let mut r = *r;
+                for t in first..first + count {
+                    r.t_max = c.t_max();
+                    let tri = self.triangle(t);
+                    let at = At {
+                        set,
+                        index: self.id(t),
+                        loc: t as u32,
+                    };
+                    let record = |w: &Winners<L>| Triangle::records(&rays, w, cull, |_| Some(tri));
+                    let p = TrianglePacket::splat(&tri);
+                    let stop = if C::EVERY {
+                        K::each(&r, &pre, &p, cull, |h| c.offer(h, at, record))
+                    } else {
+                        let h = K::first(&r, &pre, &p, cull);
+                        h.mask.any() && c.offer(&h, at, record)
+                    };
+                    if stop {
+                        return true;
+                    }
+                }
+                false
+            },
+            split::<L, C>(),
+            |start, i, c| {
+                self.trace_from::<K, _>(
+                    cull,
+                    &rays.lane_ray(i),
+                    start,
+                    set,
+                    &mut LaneOf::new(c, i),
+                );
+                c.active().none()
+            },
+        )
+    }
+
+    #[inline]
+    fn trace_ray_with<K: Kernel<Triangle>, C: Collector<f32>>(
+        &self,
+        cull: Cull,
+        ray: &Ray,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        if C::EVERY {
+            return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
+        }
+        if K::UNIT_DIRECTIONS && (ray.dir().length_squared() - 1.0).abs() > UNIT_TOLERANCE {
+            return false;
+        }
+        self.trace_from::<K, C>(cull, ray, 0, set, c)
     }
 
     #[inline]

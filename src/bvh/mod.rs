@@ -128,7 +128,7 @@ pub use scene::{Inst4, Instance, Scene};
 
 use wide::f32x4;
 
-use crate::hit::{At, Collector, Hits, Record, Winners};
+use crate::hit::{At, Collector, Hits, LaneOf, Record, Winners};
 use crate::kernel::{Cull, Kernel, LaneHit, admit};
 use crate::lane::{Lane, Mask};
 use crate::ray::{Ray, RayPacket, UNIT_TOLERANCE};
@@ -527,44 +527,19 @@ pub struct Stats {
     pub bytes: usize,
 }
 
-/// A BVH answers as the flat set it was built over, with the same kernel and culling: the
-/// same closest [`Hit`](crate::Hit) bit for bit (see the [module docs](self)), for one ray
-/// (children in `f32x8` lanes, leaves in `f32x4` lanes: 1 ray × 4 primitives) and for packets
-/// of every width (N rays × 1 primitive in the leaves); `any` agrees; `all` reports each hit
-/// primitive's records as the flat set does, in traversal order.
-impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
-    type Prim = P::Prim;
-    type Kernel = P::Kernel;
-
-    #[inline]
-    fn trace_with<K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
-        &self,
-        cull: Cull,
-        rays: &RayPacket<L>,
-        set: u32,
-        c: &mut C,
-    ) -> bool {
-        let rays = admit(rays, K::UNIT_DIRECTIONS);
-        let pre = K::prepare(&rays);
-        traverse::many(self.nodes, self.reach, &rays, c, |li, r, c| {
-            leaf_many::<P, K, L, C>(self.leaves, li, &rays, r, &pre, cull, set, c)
-        })
-    }
-
-    #[inline]
-    fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
+impl<P: Leaf, N: Layout> Bvh<'_, P, N> {
+    /// One ray from the node reference `start` (0: the root) into `c`: children in lanes,
+    /// nearest first, a leaf's primitives in `f32x4` lanes (1 ray × 4 primitives). The one-ray
+    /// query, and the packets' lanes that continue alone.
+    #[inline(always)]
+    fn trace_from<K: Kernel<P::Prim>, C: Collector<f32>>(
         &self,
         cull: Cull,
         ray: &Ray,
+        start: u32,
         set: u32,
         c: &mut C,
     ) -> bool {
-        if C::EVERY {
-            return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
-        }
-        if K::UNIT_DIRECTIONS && (ray.dir().length_squared() - 1.0).abs() > UNIT_TOLERANCE {
-            return false;
-        }
         let r4 = RayPacket::<f32x4>::splat(ray).shrink(Mask::splat(true), f32x4::splat(c.t_max()));
         // The kernel's per-ray set-up (Watertight: the shear, 3 divisions), made at the first
         // leaf: most rays that leave a surface reach none.
@@ -573,6 +548,7 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
             self.nodes,
             self.reach,
             ray,
+            start,
             c,
             #[inline(always)]
             |li, c| {
@@ -609,6 +585,90 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
                 false
             },
         )
+    }
+}
+
+/// Lanes at or below which a packet's subtree continues lane by lane as single rays (`0`:
+/// never): for plain `f32` packets and collectors that keep one hit per lane (closest, any).
+/// Measured on the bunny and its subdivisions (`benches/examples/scenes.rs`): see
+/// `docs/benchmarks.md`.
+#[inline(always)]
+pub(crate) const fn split<L: Lane, C: Collector<L>>() -> u32 {
+    if L::PLAIN_F32 && !C::EVERY && L::LANES > 1 {
+        (L::LANES / 4) as u32
+    } else {
+        0
+    }
+}
+
+impl Stats {
+    /// Children per inner node (of [`WIDTH`]): `(nodes − 1 + leaves) / nodes`.
+    #[must_use]
+    pub fn children_per_node(&self) -> f64 {
+        (self.nodes + self.leaves).saturating_sub(1) as f64 / self.nodes.max(1) as f64
+    }
+
+    /// Primitives per leaf (of [`LEAF_WIDTH`]).
+    #[must_use]
+    pub fn primitives_per_leaf(&self) -> f64 {
+        self.primitives as f64 / self.leaves.max(1) as f64
+    }
+}
+
+/// A BVH answers as the flat set it was built over, with the same kernel and culling: the
+/// same closest [`Hit`](crate::Hit) bit for bit (see the [module docs](self)), for one ray
+/// (children in `f32x8` lanes, leaves in `f32x4` lanes: 1 ray × 4 primitives) and for packets
+/// of every width (N rays × 1 primitive in the leaves); `any` agrees; `all` reports each hit
+/// primitive's records as the flat set does, in traversal order.
+impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
+    type Prim = P::Prim;
+    type Kernel = P::Kernel;
+
+    #[inline]
+    fn trace_with<K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        let rays = admit(rays, K::UNIT_DIRECTIONS);
+        let pre = K::prepare(&rays);
+        traverse::many(
+            self.nodes,
+            self.reach,
+            &rays,
+            c,
+            |li, r, c| leaf_many::<P, K, L, C>(self.leaves, li, &rays, r, &pre, cull, set, c),
+            split::<L, C>(),
+            |start, i, c| {
+                self.trace_from::<K, _>(
+                    cull,
+                    &rays.lane_ray(i),
+                    start,
+                    set,
+                    &mut LaneOf::new(c, i),
+                );
+                c.active().none()
+            },
+        )
+    }
+
+    #[inline]
+    fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
+        &self,
+        cull: Cull,
+        ray: &Ray,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        if C::EVERY {
+            return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
+        }
+        if K::UNIT_DIRECTIONS && (ray.dir().length_squared() - 1.0).abs() > UNIT_TOLERANCE {
+            return false;
+        }
+        self.trace_from::<K, C>(cull, ray, 0, set, c)
     }
 
     #[inline]

@@ -51,23 +51,23 @@ pub trait Layout: Copy + core::fmt::Debug {
     ) -> (L::Mask, L);
 }
 
-/// What a traversal needs of its stack: node references with the entry parameters of their
-/// boxes, last in first out; a push that does not fit is recorded (the traversal then runs
-/// again with a larger stack).
+/// What a traversal needs of its stack: node references with a 32-bit key each (a ray's
+/// entry parameter's bits, or a packet's lanes), last in first out; a push that does not fit
+/// is recorded (the traversal then runs again with a larger stack).
 pub trait Entries {
     /// An empty stack.
     fn new() -> Self;
     /// The last entry pushed, removed.
-    fn pop(&mut self) -> Option<(u32, f32)>;
+    fn pop(&mut self) -> Option<(u32, u32)>;
     /// Pushes an entry (or records the overflow).
-    fn push(&mut self, node: u32, t: f32);
+    fn push(&mut self, node: u32, key: u32);
     /// True when a push did not fit.
     fn overflowed(&self) -> bool;
 }
 
-/// A stack of `N` node references alone (4 bytes each; a popped entry's parameter is `−inf`,
-/// so the traversal prunes at the node's own test rather than before it): the small stack of
-/// [`Node4`] traversals.
+/// A stack of `N` node references alone (4 bytes each; a popped entry's key is `−inf`'s
+/// bits, so a one-ray traversal prunes at the node's own test rather than before it): the
+/// small stack of [`Node4`] traversals.
 #[derive(Debug)]
 pub struct Refs<const N: usize> {
     node: [u32; N],
@@ -86,13 +86,13 @@ impl<const N: usize> Entries for Refs<N> {
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, f32)> {
+    fn pop(&mut self) -> Option<(u32, u32)> {
         self.len = self.len.checked_sub(1)?;
-        Some((*self.node.get(self.len)?, f32::NEG_INFINITY))
+        Some((*self.node.get(self.len)?, f32::NEG_INFINITY.to_bits()))
     }
 
     #[inline(always)]
-    fn push(&mut self, node: u32, _: f32) {
+    fn push(&mut self, node: u32, _: u32) {
         if let Some(a) = self.node.get_mut(self.len) {
             *a = node;
             self.len += 1;
@@ -111,7 +111,7 @@ impl<const N: usize> Entries for Refs<N> {
 #[derive(Debug)]
 pub struct Stack<const N: usize> {
     node: [u32; N],
-    tn: [f32; N],
+    key: [u32; N],
     len: usize,
     overflow: bool,
 }
@@ -121,23 +121,23 @@ impl<const N: usize> Entries for Stack<N> {
     fn new() -> Self {
         Stack {
             node: [0; N],
-            tn: [0.0; N],
+            key: [0; N],
             len: 0,
             overflow: false,
         }
     }
 
     #[inline(always)]
-    fn pop(&mut self) -> Option<(u32, f32)> {
+    fn pop(&mut self) -> Option<(u32, u32)> {
         self.len = self.len.checked_sub(1)?;
-        Some((*self.node.get(self.len)?, *self.tn.get(self.len)?))
+        Some((*self.node.get(self.len)?, *self.key.get(self.len)?))
     }
 
     #[inline(always)]
-    fn push(&mut self, node: u32, t: f32) {
-        if let (Some(a), Some(b)) = (self.node.get_mut(self.len), self.tn.get_mut(self.len)) {
+    fn push(&mut self, node: u32, key: u32) {
+        if let (Some(a), Some(b)) = (self.node.get_mut(self.len), self.key.get_mut(self.len)) {
             *a = node;
-            *b = t;
+            *b = key;
             self.len += 1;
         } else {
             self.overflow = true;

@@ -313,21 +313,29 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         set: u32,
         c: &mut C,
     ) -> bool {
-        traverse::many(self.top.nodes, self.top.reach, rays, c, |li, r, c| {
-            let Some(leaf) = self.top.leaves.get(li as usize) else {
-                return false;
-            };
-            for &i in leaf.indices() {
-                let Some((inst, object)) = self.placed(i) else {
-                    continue;
+        traverse::many(
+            self.top.nodes,
+            self.top.reach,
+            rays,
+            c,
+            |li, r, c| {
+                let Some(leaf) = self.top.leaves.get(li as usize) else {
+                    return false;
                 };
-                let local = inst.packet_to_object(r);
-                if object.trace_with::<K, L, C>(cull, &local, set + i, c) {
-                    return true;
+                for &i in leaf.indices() {
+                    let Some((inst, object)) = self.placed(i) else {
+                        continue;
+                    };
+                    let local = inst.packet_to_object(r);
+                    if object.trace_with::<K, L, C>(cull, &local, set + i, c) {
+                        return true;
+                    }
                 }
-            }
-            false
-        })
+                false
+            },
+            0,
+            |_, _, _| false,
+        )
     }
 
     fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
@@ -340,7 +348,7 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         if C::EVERY {
             return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
         }
-        traverse::one(self.top.nodes, self.top.reach, ray, c, |li, c| {
+        traverse::one(self.top.nodes, self.top.reach, ray, 0, c, |li, c| {
             let Some(leaf) = self.top.leaves.get(li as usize) else {
                 return false;
             };

@@ -5,26 +5,38 @@
 //! what happens at a leaf (a closure: kernels over primitives, or instances traversed in turn).
 //!
 //! A leaf closure offers its candidates to the collector and returns true when the collector
-//! asked to stop; the loops read the collector's `t_max` to prune. A traversal whose short
-//! stack overflows runs again with the full one (keeping what the collector found: a closest
-//! hit found is still a candidate, and `any` had found nothing), except for collectors that
-//! report every hit, which start with the full stack.
+//! asked to stop; the loops read the collector's `t_max` to prune. A one-ray traversal whose
+//! short stack overflows runs again with the full one (keeping what the collector found: a
+//! closest hit found is still a candidate, and `any` had found nothing), except for
+//! collectors that report every hit, which start with the full stack.
+//!
+//! A packet's stack entries carry the lanes that entered each box, so a subtree only a few
+//! lanes reach continues as single rays ([`many`]'s `single`: the caller's one-ray traversal
+//! from that node, lane by lane; Embree's hybrid traversal does the same): a packet then
+//! never does much more work than its rays traced one by one, whatever their coherence.
 
-use super::node::{Entries, Frustum, Layout, PacketSlab, Slab, highest};
-use super::{EMPTY, LEAF, WIDTH};
+use super::node::{Entries, Frustum, Layout, PacketSlab, Slab, Stack, highest};
+use super::{EMPTY, LEAF, STACK, WIDTH};
 use crate::hit::Collector;
 use crate::lane::{Lane, Mask, Scalar};
 use crate::ray::{Ray, RayPacket};
 
-/// Pushes the children of `n` in `bits` farthest first (so the nearest is popped first).
+/// Pushes the children of `n` in `bits` farthest first by `tn` (so the nearest is popped
+/// first), child `k` with the key `key(k)`.
 #[inline(always)]
-fn push_sorted<N: Layout, S: Entries>(stack: &mut S, n: &N, mut bits: u32, tn: &[f32; WIDTH]) {
+fn push_sorted<N: Layout, S: Entries>(
+    stack: &mut S,
+    n: &N,
+    mut bits: u32,
+    tn: &[f32; WIDTH],
+    key: impl Fn(usize) -> u32,
+) {
     let mut list = [(0u32, 0.0f32); WIDTH];
     let mut m = 0;
     while bits != 0 {
         let k = bits.trailing_zeros() as usize;
         bits &= bits - 1;
-        let item = (n.child(k), tn[k]);
+        let item = (k as u32, tn[k]);
         // Insertion sort, descending entry parameter.
         let mut j = m;
         while j > 0 && list[j - 1].1 < item.1 {
@@ -34,38 +46,44 @@ fn push_sorted<N: Layout, S: Entries>(stack: &mut S, n: &N, mut bits: u32, tn: &
         list[j] = item;
         m += 1;
     }
-    for &(c, t) in &list[..m] {
-        stack.push(c, t);
+    for &(k, _) in &list[..m] {
+        stack.push(n.child(k as usize), key(k as usize));
     }
 }
 
 /// One ray through the tree `nodes` (root first; `reach`: the largest coordinate of the
-/// root's children): `leaf(i, c)` for every leaf `i` reached whose box the interval meets,
-/// nearest first, until it returns true (then so does this).
+/// root's children) from the node reference `start` (0: the root; an inner node or a leaf):
+/// `leaf(i, c)` for every leaf `i` reached whose box the interval meets, nearest first,
+/// until it returns true (then so does this).
 #[inline(always)]
 pub(crate) fn one<N: Layout, C: Collector<f32>>(
     nodes: &[N],
     reach: f32,
     ray: &Ray,
+    start: u32,
     c: &mut C,
     mut leaf: impl FnMut(u32, &mut C) -> bool,
 ) -> bool {
+    if start & LEAF != 0 {
+        return start != EMPTY && ray.is_valid() && leaf(start & !LEAF, c);
+    }
     if !C::EVERY
         && size_of::<N::Short>() < size_of::<N::Full>()
-        && let Some(stop) = one_with::<N::Short, N, C>(nodes, reach, ray, c, &mut leaf)
+        && let Some(stop) = one_with::<N::Short, N, C>(nodes, reach, ray, start, c, &mut leaf)
     {
         return stop;
     }
-    one_with::<N::Full, N, C>(nodes, reach, ray, c, &mut leaf).unwrap_or(false)
+    one_with::<N::Full, N, C>(nodes, reach, ray, start, c, &mut leaf).unwrap_or(false)
 }
 
-/// [`one`] with the stack `S`: `None` when it overflowed (never with the layout's full stack,
-/// by the depth bound).
+/// [`one`] from the inner node `start` with the stack `S`: `None` when it overflowed (never
+/// with the layout's full stack, by the depth bound).
 #[inline(always)]
 fn one_with<S: Entries, N: Layout, C: Collector<f32>>(
     nodes: &[N],
     reach: f32,
     ray: &Ray,
+    start: u32,
     c: &mut C,
     leaf: &mut impl FnMut(u32, &mut C) -> bool,
 ) -> Option<bool> {
@@ -73,25 +91,25 @@ fn one_with<S: Entries, N: Layout, C: Collector<f32>>(
         return Some(false);
     }
     let slab = Slab::new(ray.origin(), ray.dir(), reach);
-    // The root is tested before the stack is set up: a ray that meets none of its children
-    // (most rays leaving a convex part) costs one node test.
-    let Some(root) = nodes.first() else {
+    // The first node is tested before the stack is set up: a ray that meets none of the
+    // root's children (most rays leaving a convex part) costs one node test.
+    let Some(first) = nodes.get(start as usize) else {
         return Some(false);
     };
-    let (bits, tn) = root.test_one(&slab, ray.t_min(), c.t_max());
+    let (bits, tn) = first.test_one(&slab, ray.t_min(), c.t_max());
     if bits == 0 {
         return Some(false);
     }
     let mut stack = S::new();
-    push_sorted(&mut stack, root, bits, &tn);
-    while let Some((r, tn)) = stack.pop() {
-        if C::SHRINKS && tn > c.t_max() {
+    push_sorted(&mut stack, first, bits, &tn, |k| tn[k].to_bits());
+    while let Some((r, key)) = stack.pop() {
+        if C::SHRINKS && f32::from_bits(key) > c.t_max() {
             continue;
         }
         if r & LEAF == 0 {
             if let Some(n) = nodes.get(r as usize) {
                 let (bits, tn) = n.test_one(&slab, ray.t_min(), c.t_max());
-                push_sorted(&mut stack, n, bits, &tn);
+                push_sorted(&mut stack, n, bits, &tn, |k| tn[k].to_bits());
             }
             continue;
         }
@@ -102,8 +120,11 @@ fn one_with<S: Entries, N: Layout, C: Collector<f32>>(
     (!stack.overflowed()).then_some(false)
 }
 
-/// A packet through the tree `nodes` (as [`one`]): `leaf(i, rays, c)` for every leaf `i` some
-/// active lane reaches, with the rays' `t_max` the collector's, until it returns true.
+/// A packet through the tree `nodes` (as [`one`]): `leaf(i, rays, c)` for every leaf `i` more
+/// than `split` active lanes reach, with the rays' `t_max` the collector's, and
+/// `single(r, lane, c)` for each lane of a subtree `r` (inner node or leaf) that `split` or
+/// fewer active lanes reach (`split = 0`: never), until one returns true. `single` runs the
+/// lane as one ray from `r` and returns true when the packet may stop.
 #[inline(always)]
 pub(crate) fn many<N: Layout, L: Lane, C: Collector<L>>(
     nodes: &[N],
@@ -111,15 +132,22 @@ pub(crate) fn many<N: Layout, L: Lane, C: Collector<L>>(
     rays: &RayPacket<L>,
     c: &mut C,
     mut leaf: impl FnMut(u32, &RayPacket<L>, &mut C) -> bool,
+    split: u32,
+    mut single: impl FnMut(u32, usize, &mut C) -> bool,
 ) -> bool {
     if !C::EVERY
-        && size_of::<N::Short>() < size_of::<N::Full>()
-        && let Some(stop) = many_with::<N::Short, N, L, C>(nodes, reach, rays, c, &mut leaf)
+        && let Some(stop) =
+            many_with::<Stack<SHORT>, N, L, C>(nodes, reach, rays, c, &mut leaf, split, &mut single)
     {
         return stop;
     }
-    many_with::<N::Full, N, L, C>(nodes, reach, rays, c, &mut leaf).unwrap_or(false)
+    many_with::<Stack<STACK>, N, L, C>(nodes, reach, rays, c, &mut leaf, split, &mut single)
+        .unwrap_or(false)
 }
+
+/// Entries of a packet's first stack (a traversal that overflows it runs again with
+/// [`STACK`]).
+const SHORT: usize = 32;
 
 /// [`many`] with the stack `S`: `None` when it overflowed.
 #[inline(always)]
@@ -129,10 +157,12 @@ fn many_with<S: Entries, N: Layout, L: Lane, C: Collector<L>>(
     rays: &RayPacket<L>,
     c: &mut C,
     leaf: &mut impl FnMut(u32, &RayPacket<L>, &mut C) -> bool,
+    split: u32,
+    single: &mut impl FnMut(u32, usize, &mut C) -> bool,
 ) -> Option<bool> {
     crate::lane::assert_fits::<L>();
     let valid = c.active() & rays.valid();
-    if valid.none() {
+    if valid.none() || nodes.is_empty() {
         return Some(false);
     }
     let slab = PacketSlab::new(rays, reach);
@@ -141,15 +171,31 @@ fn many_with<S: Entries, N: Layout, L: Lane, C: Collector<L>>(
         ..*rays
     };
     let mut fr = frustum(&slab, &r, valid);
+    let one_eye = fr.as_ref().is_some_and(|f| f.one_eye);
+    let split = if one_eye { 0 } else { split };
     let mut stack = S::new();
-    if let Some(root) = nodes.first() {
-        visit(&mut stack, root, &slab, &r, valid, fr.as_ref());
-    }
-    while let Some((n, _)) = stack.pop() {
+    stack.push(0, valid.bits());
+    while let Some((n, lanes)) = stack.pop() {
+        // The lanes that entered this box and still look for hits.
+        let active = c.active() & valid;
+        let lanes = lanes & active.bits();
+        if lanes == 0 {
+            continue;
+        }
+        if lanes.count_ones() <= split {
+            let mut b = lanes;
+            while b != 0 {
+                let i = b.trailing_zeros() as usize;
+                b &= b - 1;
+                if single(n, i, c) {
+                    return Some(true);
+                }
+            }
+            continue;
+        }
         if n & LEAF == 0 {
             if let Some(node) = nodes.get(n as usize) {
-                let active = c.active() & valid;
-                visit(&mut stack, node, &slab, &r, active, fr.as_ref());
+                visit(&mut stack, node, &slab, &r, active, lanes, fr.as_ref());
             }
             continue;
         }
@@ -161,34 +207,56 @@ fn many_with<S: Entries, N: Layout, L: Lane, C: Collector<L>>(
         if t.lt(r.t_max).any() {
             r.t_max = t;
             if let Some(f) = fr.as_mut() {
-                f.2 = highest(t, valid);
+                f.t_hi = highest(t, valid);
             }
         }
     }
     (!stack.overflowed()).then_some(false)
 }
 
-/// A packet's [`Frustum`] with its lanes' lowest `t_min` and highest `t_max`.
+/// True when the `valid` lanes of `rays` share their origin, bit for bit.
 #[inline(always)]
-fn frustum<L: Lane>(
-    slab: &PacketSlab<L>,
-    rays: &RayPacket<L>,
-    valid: L::Mask,
-) -> Option<(Frustum, f32, f32)> {
+fn same_origin<L: Lane>(rays: &RayPacket<L>, valid: L::Mask) -> bool {
+    let o = rays.origin();
+    let Some(first) = (0..L::LANES).find(|&i| valid.test(i)) else {
+        return false;
+    };
+    let (x, y, z) = (o.x.lane(first), o.y.lane(first), o.z.lane(first));
+    let same =
+        o.x.ge(L::splat(x)) & o.x.le(L::splat(x)) & o.y.ge(L::splat(y)) & o.y.le(L::splat(y));
+    (same & o.z.ge(L::splat(z)) & o.z.le(L::splat(z)) | !valid).all()
+}
+
+/// A packet's [`Frustum`], tested against a node's children for the whole packet at once.
+struct Cone {
+    f: Frustum,
+    /// The lanes' lowest `t_min` and highest `t_max`.
+    t_lo: f32,
+    t_hi: f32,
+    /// Rays from one point (a camera's): the frustum is tight, and the lanes of an inner child
+    /// it enters are not tested one by one (they are at its leaves).
+    one_eye: bool,
+}
+
+/// A packet's [`Cone`], where it has more than one lane.
+#[inline(always)]
+fn frustum<L: Lane>(slab: &PacketSlab<L>, rays: &RayPacket<L>, valid: L::Mask) -> Option<Cone> {
     // One lane: its own per-child test is as tight and, where `f32x8` is emulated (Cortex-M),
     // cheaper (4,941 against 9,447 instructions per primary ray on the M4F).
     if L::LANES == 1 {
         return None;
     }
-    let f = Frustum::new(slab, valid)?;
-    let lo = -highest(-rays.t_min, valid);
-    Some((f, lo, highest(rays.t_max, valid)))
+    Some(Cone {
+        f: Frustum::new(slab, valid)?,
+        t_lo: -highest(-rays.t_min, valid),
+        t_hi: highest(rays.t_max, valid),
+        one_eye: same_origin(rays, valid),
+    })
 }
 
-/// Pushes the children of node `n` some lane of `active` enters, nearest (by the first such
-/// lane's entry) on top. With a [`Frustum`], the children are tested for the whole packet at
-/// once (`t_lo`, `t_hi`: the lanes' lowest `t_min` and highest `t_max`), and a leaf child only
-/// if some lane's own test enters it.
+/// Pushes the children of node `n` some of the lanes `lanes` enter, each with the lanes that
+/// enter it, nearest (by the first such lane's entry) on top. With a [`Cone`], the children
+/// are first tested for the whole packet at once, and only those it enters lane by lane.
 #[inline(always)]
 fn visit<N: Layout, L: Lane, S: Entries>(
     stack: &mut S,
@@ -196,36 +264,34 @@ fn visit<N: Layout, L: Lane, S: Entries>(
     slab: &PacketSlab<L>,
     r: &RayPacket<L>,
     active: L::Mask,
-    fr: Option<&(Frustum, f32, f32)>,
+    lanes: u32,
+    fr: Option<&Cone>,
 ) {
-    if let Some((f, t_lo, t_hi)) = fr {
-        let (mut bits, tn) = n.test_frustum(f, *t_lo, *t_hi);
-        let mut leaves = bits;
-        while leaves != 0 {
-            let k = leaves.trailing_zeros() as usize;
-            leaves &= leaves - 1;
-            if n.child(k) & LEAF != 0 {
-                let (m, _) = n.test_lanes(slab, k, r.t_min, r.t_max, active);
-                if m.none() {
-                    bits &= !(1 << k);
-                }
-            }
-        }
-        push_sorted(stack, n, bits, &tn);
-        return;
-    }
-    let mut bits = 0u32;
-    let mut key = [0.0f32; WIDTH];
-    for (k, key) in key.iter_mut().enumerate() {
-        if n.child(k) == EMPTY {
+    let one_eye = fr.is_some_and(|c| c.one_eye);
+    let (mut bits, mut key) = match fr {
+        Some(c) => n.test_frustum(&c.f, c.t_lo, c.t_hi),
+        None => (
+            (0..WIDTH).fold(0, |b, k| b | (u32::from(n.child(k) != EMPTY) << k)),
+            [0.0; WIDTH],
+        ),
+    };
+    let mut entered = [0u32; WIDTH];
+    let mut todo = bits;
+    while todo != 0 {
+        let k = todo.trailing_zeros() as usize;
+        todo &= todo - 1;
+        if one_eye && n.child(k) & LEAF == 0 {
+            entered[k] = lanes;
             continue;
         }
         let (m, tn) = n.test_lanes(slab, k, r.t_min, r.t_max, active);
-        let mb = m.bits();
-        if mb != 0 {
-            bits |= 1 << k;
-            *key = tn.lane(mb.trailing_zeros() as usize).to_f64() as f32;
+        let mb = m.bits() & lanes;
+        if mb == 0 {
+            bits &= !(1 << k);
+        } else {
+            entered[k] = mb;
+            key[k] = tn.lane(mb.trailing_zeros() as usize).to_f64() as f32;
         }
     }
-    push_sorted(stack, n, bits, &key);
+    push_sorted(stack, n, bits, &key, |k| entered[k]);
 }
