@@ -21,8 +21,9 @@ use crate::hit::Collector;
 use crate::lane::{Lane, Mask, Scalar};
 use crate::ray::{Ray, RayPacket};
 
-/// Pushes the children of `n` in `bits` farthest first by `tn` (so the nearest is popped
-/// first), child `k` with the key `key(k)`.
+/// Pushes the children of `n` in `bits` but the nearest, farthest first by `tn`, child `k`
+/// with the key `key(k)`, and returns the nearest (its reference and key), which the caller
+/// visits next without a push (or pushes last).
 #[inline(always)]
 fn push_sorted<N: Layout, S: Entries>(
     stack: &mut S,
@@ -30,7 +31,7 @@ fn push_sorted<N: Layout, S: Entries>(
     mut bits: u32,
     tn: &[f32; WIDTH],
     key: impl Fn(usize) -> u32,
-) {
+) -> Option<(u32, u32)> {
     let mut list = [(0u32, 0.0f32); WIDTH];
     let mut m = 0;
     while bits != 0 {
@@ -46,9 +47,11 @@ fn push_sorted<N: Layout, S: Entries>(
         list[j] = item;
         m += 1;
     }
-    for &(k, _) in &list[..m] {
+    let (&(near, _), rest) = list[..m].split_last()?;
+    for &(k, _) in rest {
         stack.push(n.child(k as usize), key(k as usize));
     }
+    Some((n.child(near as usize), key(near as usize)))
 }
 
 /// One ray through the tree `nodes` (root first; `reach`: the largest coordinate of the
@@ -101,23 +104,31 @@ fn one_with<S: Entries, N: Layout, C: Collector<f32>>(
         return Some(false);
     }
     let mut stack = S::new();
-    push_sorted(&mut stack, first, bits, &tn, |k| tn[k].to_bits());
-    while let Some((r, key)) = stack.pop() {
-        if C::SHRINKS && f32::from_bits(key) > c.t_max() {
-            continue;
-        }
+    // The nearest child entered is visited next, without a push (Embree's order).
+    let Some((mut r, _)) = push_sorted(&mut stack, first, bits, &tn, |k| tn[k].to_bits()) else {
+        return Some(false);
+    };
+    loop {
         if r & LEAF == 0 {
             if let Some(n) = nodes.get(r as usize) {
                 let (bits, tn) = n.test_one(&slab, ray.t_min(), c.t_max());
-                push_sorted(&mut stack, n, bits, &tn, |k| tn[k].to_bits());
+                if let Some((near, _)) = push_sorted(&mut stack, n, bits, &tn, |k| tn[k].to_bits())
+                {
+                    r = near;
+                    continue;
+                }
             }
-            continue;
-        }
-        if leaf(r & !LEAF, c) {
+        } else if leaf(r & !LEAF, c) {
             return Some(true);
         }
+        r = loop {
+            match stack.pop() {
+                Some((r, key)) if !(C::SHRINKS && f32::from_bits(key) > c.t_max()) => break r,
+                Some(_) => {}
+                None => return (!stack.overflowed()).then_some(false),
+            }
+        };
     }
-    (!stack.overflowed()).then_some(false)
 }
 
 /// A packet through the tree `nodes` (as [`one`]): `leaf(i, rays, c)` for every leaf `i` more
@@ -293,5 +304,7 @@ fn visit<N: Layout, L: Lane, S: Entries>(
             key[k] = tn.lane(mb.trailing_zeros() as usize).to_f64() as f32;
         }
     }
-    push_sorted(stack, n, bits, &key, |k| entered[k]);
+    if let Some((r, lanes)) = push_sorted(stack, n, bits, &key, |k| entered[k]) {
+        stack.push(r, lanes);
+    }
 }
