@@ -5,7 +5,7 @@
 //! ([`include_baked!`](crate::include_baked)) and opens without copying ([`Baked::open`]): the
 //! bytes are checked once and then viewed in place, so a query needs no RAM beside its stack:
 //! [`STACK4`] node references (196 bytes) and its frames, about 1 KB in all (measured by
-//! stack painting on the six QEMU boards: 744 B on rv32imafc to 908 B on the Cortex-M0).
+//! stack painting on the six QEMU boards: 736 B on rv32imafc to 916 B on the Cortex-M0).
 //!
 //! ```
 //! use raylane::bvh::bake::{Baked, bake};
