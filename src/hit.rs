@@ -458,6 +458,18 @@ impl<L: Lane> Collector<L> for Any<L> {
     }
 }
 
+/// Lane `i` of the packet collector `c` traced alone by `trace` (a packet lane continued as
+/// one ray); true when every lane of `c` is done.
+#[inline(always)]
+pub(crate) fn alone<L: Lane, C: Collector<L>>(
+    c: &mut C,
+    i: usize,
+    trace: impl FnOnce(&mut LaneOf<'_, L, C>) -> bool,
+) -> bool {
+    trace(&mut LaneOf::new(c, i));
+    c.active().none()
+}
+
 /// Lane `i` of a packet's collector as a one-ray collector: a packet lane continued as a
 /// single ray (the BVH's hybrid traversal). Its activity and `t_max` are the lane's, its
 /// candidates go to the lane (the same rule, so the same answer); it asks its traversal to

@@ -8,7 +8,7 @@
 //! ray in every lane: a BVH leaf's primitives against one ray).
 
 use crate::lane::{Lane, Mask};
-use crate::ray::{RayPacket, UNIT_TOLERANCE};
+use crate::ray::{Ray, RayPacket, UNIT_TOLERANCE};
 
 /// One lane-wise test result: the parameter `t`, two surface parameters `u`, `v`
 /// (barycentrics for triangles, scaled by `w` while a query runs; for spheres `u = 1` marks
@@ -159,6 +159,14 @@ pub trait Kernel<P: Primitive> {
         let h = Self::first(rays, pre, prim, cull);
         h.mask.any() && f(&h)
     }
+}
+
+/// Whether a kernel can answer `ray`: for kernels that need unit directions, false when
+/// `|d|²` is more than [`UNIT_TOLERANCE`] from 1 ([`admit`] for one ray: such a ray misses).
+#[inline(always)]
+#[must_use]
+pub(crate) fn admits(ray: &Ray, unit_directions: bool) -> bool {
+    !(unit_directions && (ray.dir().length_squared() - 1.0).abs() > UNIT_TOLERANCE)
 }
 
 /// The rays a kernel can answer: for kernels that need unit directions, lanes whose `|d|²`

@@ -60,10 +60,10 @@ use wide::f32x4;
 
 use super::node::{Layout, MAX_DEPTH4, Node4, SIMD, STACK4};
 use super::{EMPTY, LEAF, split, traverse};
-use crate::hit::{At, Collector, Hits, LaneOf, Record, Winners};
-use crate::kernel::{Cull, Kernel, LaneHit, admit};
+use crate::hit::{At, Collector, Hits, Record, Winners, alone};
+use crate::kernel::{Cull, Kernel, LaneHit, admit, admits};
 use crate::lane::{Lane, Mask};
-use crate::ray::{Ray, RayPacket, UNIT_TOLERANCE};
+use crate::ray::{Ray, RayPacket};
 use crate::set::{Set, mine};
 use crate::triangle::{Triangle, TrianglePacket, Watertight};
 use crate::vec3::V3;
@@ -552,14 +552,9 @@ impl Set for Baked<'_> {
             },
             split::<L, C>(),
             |start, i, c| {
-                self.trace_from::<K, _>(
-                    cull,
-                    &rays.lane_ray(i),
-                    start,
-                    set,
-                    &mut LaneOf::new(c, i),
-                );
-                c.active().none()
+                alone(c, i, |one| {
+                    self.trace_from::<K, _>(cull, &rays.lane_ray(i), start, set, one)
+                })
             },
         )
     }
@@ -575,7 +570,7 @@ impl Set for Baked<'_> {
         if C::EVERY {
             return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
         }
-        if K::UNIT_DIRECTIONS && (ray.dir().length_squared() - 1.0).abs() > UNIT_TOLERANCE {
+        if !admits(ray, K::UNIT_DIRECTIONS) {
             return false;
         }
         self.trace_from::<K, C>(cull, ray, 0, set, c)

@@ -128,10 +128,10 @@ pub use scene::{Inst4, Instance, Scene};
 
 use wide::f32x4;
 
-use crate::hit::{At, Collector, Hits, LaneOf, Record, Winners};
-use crate::kernel::{Cull, Kernel, LaneHit, admit};
+use crate::hit::{At, Collector, Hits, Record, Winners, alone};
+use crate::kernel::{Cull, Kernel, LaneHit, admit, admits};
 use crate::lane::{Lane, Mask};
-use crate::ray::{Ray, RayPacket, UNIT_TOLERANCE};
+use crate::ray::{Ray, RayPacket};
 use crate::set::{Set, TooSmall, mine};
 
 /// Children per node (the lanes of one slab test).
@@ -642,14 +642,9 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
             |li, r, c| leaf_many::<P, K, L, C>(self.leaves, li, &rays, r, &pre, cull, set, c),
             split::<L, C>(),
             |start, i, c| {
-                self.trace_from::<K, _>(
-                    cull,
-                    &rays.lane_ray(i),
-                    start,
-                    set,
-                    &mut LaneOf::new(c, i),
-                );
-                c.active().none()
+                alone(c, i, |one| {
+                    self.trace_from::<K, _>(cull, &rays.lane_ray(i), start, set, one)
+                })
             },
         )
     }
@@ -665,7 +660,7 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
         if C::EVERY {
             return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
         }
-        if K::UNIT_DIRECTIONS && (ray.dir().length_squared() - 1.0).abs() > UNIT_TOLERANCE {
+        if !admits(ray, K::UNIT_DIRECTIONS) {
             return false;
         }
         self.trace_from::<K, C>(cull, ray, 0, set, c)
