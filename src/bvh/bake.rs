@@ -620,8 +620,8 @@ mod alloc_only {
     use alloc::vec;
     use alloc::vec::Vec;
 
-    use super::super::build::build_width;
-    use super::super::{LEAF_WIDTH, Node, Packed, Scratch, Tri4, sizes};
+    use super::super::build::{fill, topology};
+    use super::super::{Bvh, LEAF_WIDTH, Node, Packed, Scratch, Tri4, reach, sizes};
     use super::*;
     use crate::mesh::Mesh;
 
@@ -669,10 +669,16 @@ mod alloc_only {
         let n = tris.len();
         let need = sizes(n);
         let mut nodes = vec![Node::EMPTY; n / 3 + 2];
-        let mut leaves = vec![Tri4::EMPTY; need.leaves];
         let mut scratch = vec![Scratch::default(); need.scratch];
-        let tree = build_width(&tris[..], &mut nodes, &mut leaves, &mut scratch, 4)
-            .map_err(|_| BakeError::TooMany)?;
+        let (used, l) =
+            topology(&tris[..], &mut nodes, &mut scratch, 4).map_err(|_| BakeError::TooMany)?;
+        let mut leaves = vec![Tri4::EMPTY; l];
+        fill(&tris[..], &scratch[..n], &mut leaves);
+        let tree = Bvh {
+            nodes: &nodes[..used],
+            leaves: &leaves[..],
+            reach: reach(&nodes[0]),
+        };
         // 3. Preorder numbering, then the nodes, quantized, and the triangles in leaf order.
         let mut order = vec![u32::MAX; tree.nodes.len()];
         let mut pre = Vec::with_capacity(tree.nodes.len());

@@ -290,25 +290,40 @@ fn unjob(j: &Node) -> ([u32; 4], Lanes, Box3) {
     (w, j.bounds[0], (lo, hi))
 }
 
-/// [`Bvh::build`].
+/// [`Bvh::build`]: [`topology`], then [`fill`] when `leaves` holds the leaves it counted.
 pub(crate) fn build<'s, P: Primitives + ?Sized>(
     prims: &P,
     nodes: &'s mut [Node],
     leaves: &'s mut [P::Leaf],
     scratch: &mut [Scratch],
 ) -> Result<Bvh<'s, P::Leaf>, BuildError> {
-    build_width(prims, nodes, leaves, scratch, WIDTH)
+    let (used_nodes, used_leaves) = topology(prims, nodes, scratch, WIDTH)?;
+    if leaves.len() < used_leaves {
+        return Err(BuildError::Leaves(TooSmall {
+            needed: used_leaves,
+        }));
+    }
+    fill(prims, &scratch[..prims.count()], leaves);
+    let nodes: &'s [Node] = &nodes[..used_nodes];
+    let leaves: &'s [P::Leaf] = &leaves[..used_leaves];
+    Ok(Bvh {
+        nodes,
+        leaves,
+        reach: reach(&nodes[0]),
+    })
 }
 
-/// [`build`] with at most `width` (2 to [`WIDTH`]) children per node (the others empty):
-/// the base of the 4-wide layout a bake converts.
-pub(crate) fn build_width<'s, P: Primitives + ?Sized>(
+/// The first pass of a build: the nodes, and in `scratch` the primitives in leaf order, the
+/// first entry of each leaf marked with the leaf's number and size (see [`fill`]). Returns the
+/// numbers of nodes and leaves used, so that the leaves can be stored in exactly as many
+/// slots. At most `width` (2 to [`WIDTH`]) children per node, the others empty (4: the base
+/// of the layout a bake converts).
+pub(crate) fn topology<P: Primitives + ?Sized>(
     prims: &P,
-    nodes: &'s mut [Node],
-    leaves: &'s mut [P::Leaf],
+    nodes: &mut [Node],
     scratch: &mut [Scratch],
     width: usize,
-) -> Result<Bvh<'s, P::Leaf>, BuildError> {
+) -> Result<(usize, usize), BuildError> {
     let width = width.clamp(2, WIDTH);
     let n = prims.count();
     if n > MAX_PRIMITIVES {
@@ -318,9 +333,6 @@ pub(crate) fn build_width<'s, P: Primitives + ?Sized>(
     let short = |needed| TooSmall { needed };
     if nodes.len() < need.nodes {
         return Err(BuildError::Nodes(short(need.nodes)));
-    }
-    if leaves.len() < need.leaves {
-        return Err(BuildError::Leaves(short(need.leaves)));
     }
     if scratch.len() < need.scratch {
         return Err(BuildError::Scratch(short(need.scratch)));
@@ -414,15 +426,11 @@ pub(crate) fn build_width<'s, P: Primitives + ?Sized>(
                 out.bounds[3 + axis][k] = hi[axis];
             }
             if (b - a) as usize <= LEAF_WIDTH {
-                let slot = leaves
-                    .get_mut(used_leaves)
-                    .ok_or(BuildError::Leaves(TooSmall {
-                        needed: used_leaves + 1,
-                    }))?;
-                *slot = P::Leaf::EMPTY;
-                for (lane, p) in s[a as usize..b as usize].iter().enumerate() {
-                    prims.put(p.index, slot, lane);
-                }
+                // The leaf's range is final: its first entry's centroid (no longer read)
+                // keeps the leaf's number and size for `fill`.
+                let first = &mut s[a as usize];
+                first.c[0] = f32::from_bits(used_leaves as u32);
+                first.c[1] = f32::from_bits(b - a);
                 out.child[k] = LEAF | used_leaves as u32;
                 used_leaves += 1;
             } else {
@@ -439,13 +447,24 @@ pub(crate) fn build_width<'s, P: Primitives + ?Sized>(
         }
         nodes[node] = out;
     }
-    let nodes: &'s [Node] = &nodes[..used_nodes];
-    let leaves: &'s [P::Leaf] = &leaves[..used_leaves];
-    Ok(Bvh {
-        nodes,
-        leaves,
-        reach: reach(&nodes[0]),
-    })
+    Ok((used_nodes, used_leaves))
+}
+
+/// The second pass of a build: writes each leaf from the primitives [`topology`] left in
+/// `s` (every leaf a run of entries, the first marked with its number and size).
+pub(crate) fn fill<P: Primitives + ?Sized>(prims: &P, s: &[Scratch], leaves: &mut [P::Leaf]) {
+    let mut p = 0;
+    while let Some(first) = s.get(p) {
+        let (id, size) = (first.c[0].to_bits() as usize, first.c[1].to_bits() as usize);
+        let (Some(slot), Some(run)) = (leaves.get_mut(id), s.get(p..p + size)) else {
+            return;
+        };
+        *slot = P::Leaf::EMPTY;
+        for (lane, q) in run.iter().enumerate() {
+            prims.put(q.index, slot, lane);
+        }
+        p += size.max(1);
+    }
 }
 
 /// [`Bvh::refit`].

@@ -182,7 +182,7 @@ pub struct Sizes {
 pub enum BuildError {
     /// Fewer nodes than [`Bvh::needed`] gives.
     Nodes(TooSmall),
-    /// Fewer leaves than [`Bvh::needed`] gives.
+    /// Fewer leaves than the tree uses (the exact count: see [`Bvh::needed`]).
     Leaves(TooSmall),
     /// Less scratch than [`Bvh::needed`] gives.
     Scratch(TooSmall),
@@ -258,6 +258,12 @@ impl<'s, P: Packed> Bvh<'s, P, Node> {
     /// The storage a tree over `n` primitives needs: `max(n/4, 1)` nodes, `n` leaves and `n`
     /// scratch entries (`TriangleBvh::needed(n)`, `SphereBvh::needed(n)`).
     ///
+    /// These are bounds for any input. The leaves a build uses are far fewer (about `n/4`
+    /// on real meshes, whose leaves hold 3.7–3.8 primitives): [`build`](Self::build) counts
+    /// them before it writes one, so a caller may pass fewer and, when they are short, gets
+    /// [`BuildError::Leaves`] with the exact count to build again with.
+    /// [`OwnedBvh`](crate::bvh::OwnedBvh) (feature `alloc`) allocates exactly that count.
+    ///
     /// The nodes' bound: a node stops splitting before [`WIDTH`] children only when every child
     /// is a leaf, so a node with an inner child has 8 children. Of the `I = F + B` inner nodes,
     /// the `B` without inner children hold disjoint ranges of more than [`LEAF_WIDTH`]
@@ -273,8 +279,10 @@ impl<'s, P: Packed> Bvh<'s, P, Node> {
     ///
     /// # Errors
     ///
-    /// [`BuildError`] when a slice is shorter than [`needed`](Self::needed) gives, or for more
-    /// than [`MAX_PRIMITIVES`].
+    /// [`BuildError`] when `nodes` or `scratch` is shorter than [`needed`](Self::needed) gives,
+    /// `leaves` shorter than the tree uses ([`BuildError::Leaves`] then holds the exact count;
+    /// `nodes` and `scratch` hold a first pass, to be discarded), or for more than
+    /// [`MAX_PRIMITIVES`].
     pub fn build<Q: Primitives<Leaf = P> + ?Sized>(
         prims: &Q,
         nodes: &'s mut [Node],
@@ -798,16 +806,15 @@ impl<P: Packed> OwnedBvh<P> {
         use alloc::vec;
         let need = sizes(prims.count());
         let mut nodes = vec![Node::EMPTY; need.nodes];
-        let mut leaves = vec![P::EMPTY; need.leaves];
         let mut scratch = vec![Scratch::default(); need.scratch];
-        let (n, l, reach) = {
-            let t = build::build(prims, &mut nodes, &mut leaves, &mut scratch)?;
-            (t.nodes.len(), t.leaves.len(), t.reach)
-        };
+        // The leaves are allocated once the first pass has counted them (about n/4).
+        let (n, l) = build::topology(prims, &mut nodes, &mut scratch, WIDTH)?;
+        let mut leaves = vec![P::EMPTY; l];
+        build::fill(prims, &scratch[..prims.count()], &mut leaves);
+        drop(scratch);
         nodes.truncate(n);
-        leaves.truncate(l);
         nodes.shrink_to_fit();
-        leaves.shrink_to_fit();
+        let reach = reach(&nodes[0]);
         Ok(OwnedBvh {
             nodes,
             leaves,

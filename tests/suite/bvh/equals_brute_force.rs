@@ -389,19 +389,41 @@ fn short_storage_is_an_error() {
         Some(BuildError::Nodes(TooSmall { needed: need.nodes }))
     );
     assert_eq!(
-        bvh::Bvh::build(&tris[..], &mut nodes, &mut leaves[..3], &mut scratch).err(),
-        Some(BuildError::Leaves(TooSmall {
-            needed: need.leaves
-        }))
-    );
-    assert_eq!(
         bvh::Bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch[..0]).err(),
         Some(BuildError::Scratch(TooSmall {
             needed: need.scratch
         }))
     );
-    assert!(bvh::Bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch).is_ok());
+    let (used, reference) = {
+        let t = bvh::Bvh::build(&tris[..], &mut nodes, &mut leaves, &mut scratch).unwrap();
+        (t.leaves().len(), leaf_bits(t.leaves()))
+    };
+    // Short leaves are reported with the exact count the tree uses, and that count builds
+    // the same tree.
+    assert!(used < need.leaves / 2, "{used} leaves of {}", need.leaves);
+    assert_eq!(
+        bvh::Bvh::build(&tris[..], &mut nodes, &mut leaves[..3], &mut scratch).err(),
+        Some(BuildError::Leaves(TooSmall { needed: used }))
+    );
+    let mut exact = vec![Tri4::EMPTY; used];
+    let t = bvh::Bvh::build(&tris[..], &mut nodes, &mut exact, &mut scratch).unwrap();
+    assert_eq!(leaf_bits(t.leaves()), reference);
     assert_eq!(bvh::TriangleBvh::needed(0).nodes, 1);
+}
+
+/// Leaves as bits (unused lanes hold NaN).
+fn leaf_bits(l: &[Tri4]) -> Vec<u32> {
+    l.iter()
+        .flat_map(|t| {
+            [t.a, t.b, t.c]
+                .into_iter()
+                .flatten()
+                .flatten()
+                .map(f32::to_bits)
+                .chain(t.index)
+                .collect::<Vec<_>>()
+        })
+        .collect()
 }
 
 /// Same input, same bytes (the builder uses no hashing, no addresses, no fused operations).
@@ -412,20 +434,6 @@ fn builds_are_deterministic() {
     let (n1, l1) = owned(&tris[..]);
     let (n2, l2) = owned(&tris[..]);
     assert_eq!(n1, n2);
-    // Compared as bits: unused lanes hold NaN.
-    let leaf_bits = |l: &[Tri4]| -> Vec<u32> {
-        l.iter()
-            .flat_map(|t| {
-                [t.a, t.b, t.c]
-                    .into_iter()
-                    .flatten()
-                    .flatten()
-                    .map(f32::to_bits)
-                    .chain(t.index)
-                    .collect::<Vec<_>>()
-            })
-            .collect()
-    };
     assert_eq!(leaf_bits(&l1), leaf_bits(&l2));
     // Leaves hold every triangle exactly once.
     let mut seen = vec![false; tris.len()];
