@@ -83,7 +83,7 @@ struct ReadmeDoctests;
 #[doc = include_str!("../docs/design.md")]
 struct DesignDoctests;
 
-pub use camera::Pinhole;
+pub use camera::{Pinhole, Tile};
 pub use hit::{Hit, Hits};
 pub use kernel::Cull;
 pub use lane::{Lane, Mask};

@@ -62,9 +62,10 @@
 //! `|d|²` differs from 1 by more than `2^-20` is a miss for them (a documented answer, never
 //! wrong roots); normalise directions first ([`Dir`](crate::Dir)).
 
+use crate::camera::{Tile, block};
 use crate::hit::{All, Any, Closest, Hit, Hits};
 use crate::kernel::{Cull, Kernel};
-use crate::lane::Lane;
+use crate::lane::{Lane, Mask};
 use crate::ray::{Ray, RayPacket};
 use crate::set::{Set, Trace, Using};
 
@@ -193,5 +194,51 @@ impl<L: Lane> Rays for RayPacket<L> {
     fn all<T: Trace + ?Sized>(t: &T, rays: &Self, f: &mut dyn FnMut(Hits<L>)) {
         let mut c = All::new(rays, |h: &Hits<L>| f(*h));
         t.trace(rays, 0, &mut c);
+    }
+}
+
+impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L, W, H> {
+    type Closest = [[Option<Hit>; W]; H];
+    type Any = [[bool; W]; H];
+    /// The pixel `(x, y)` of the image and its hit.
+    type Record = (u32, u32, Hit);
+
+    #[inline]
+    fn closest<T: Trace + ?Sized>(t: &T, tile: &Self) -> [[Option<Hit>; W]; H] {
+        let mut out = [[None; W]; H];
+        for (dx, dy, rays) in tile.packets() {
+            let hits = RayPacket::closest(t, &rays);
+            for i in 0..L::LANES {
+                out[dy + i / block::<L>().0][dx + i % block::<L>().0] = hits.lane(i);
+            }
+        }
+        out
+    }
+
+    #[inline]
+    fn any<T: Trace + ?Sized>(t: &T, tile: &Self) -> [[bool; W]; H] {
+        let mut out = [[false; W]; H];
+        for (dx, dy, rays) in tile.packets() {
+            let hit = RayPacket::any(t, &rays);
+            for i in 0..L::LANES {
+                out[dy + i / block::<L>().0][dx + i % block::<L>().0] = hit.test(i);
+            }
+        }
+        out
+    }
+
+    #[inline]
+    fn all<T: Trace + ?Sized>(t: &T, tile: &Self, f: &mut dyn FnMut((u32, u32, Hit))) {
+        let (x, y) = tile.origin();
+        for (dx, dy, rays) in tile.packets() {
+            RayPacket::all(t, &rays, &mut |h: Hits<L>| {
+                for i in 0..L::LANES {
+                    if let Some(hit) = h.lane(i) {
+                        let (px, py) = (dx + i % block::<L>().0, dy + i / block::<L>().0);
+                        f((x + px as u32, y + py as u32, hit));
+                    }
+                }
+            });
+        }
     }
 }

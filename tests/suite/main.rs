@@ -23,6 +23,7 @@ mod kernels {
 
 mod sets {
     pub mod bunny_visible_surface;
+    pub mod camera_tiles;
     pub mod interval_ties_and_stopping;
     pub mod query_records_every_width;
 }
