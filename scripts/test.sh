@@ -74,17 +74,19 @@ RUSTDOCFLAGS="-D warnings" cargo doc --quiet --no-deps -p raylane -p raylane-lab
 
 step "library builds: host, AArch64 and every embedded target; the lab beside it"
 for t in x86_64-unknown-linux-gnu aarch64-unknown-linux-gnu "${embedded[@]}"; do
-  for f in "" alloc; do
+  features=("" alloc)
+  case "$t" in *linux*) features+=(std) ;; esac
+  for f in "${features[@]}"; do
     cargo build --quiet --lib --target "$t" --no-default-features ${f:+--features "$f"} \
       --target-dir target/matrix || fail "the library does not build for $t with features [$f]"
   done
   cargo build --quiet --lib --target "$t" -p raylane-lab --target-dir target/matrix \
     || fail "the lab does not build for $t"
-  echo "$t: the library (no default features, alloc) and the lab build"
+  echo "$t: the library (no default features, ${features[*]:1}) and the lab build"
 done
 
 step "MSRV: the library built and tested with Rust $msrv"
-for f in "" alloc; do
+for f in "" alloc std; do
   cargo "+$msrv" build --quiet --lib --no-default-features ${f:+--features "$f"} --target-dir target/msrv
 done
 cargo "+$msrv" test --quiet -p raylane --target-dir target/msrv \

@@ -297,7 +297,7 @@ pub(crate) fn build<'s, P: Primitives + ?Sized>(
     leaves: &'s mut [P::Leaf],
     scratch: &mut [Scratch],
 ) -> Result<Bvh<'s, P::Leaf>, BuildError> {
-    let (used_nodes, used_leaves) = topology(prims, nodes, scratch, WIDTH)?;
+    let (used_nodes, used_leaves) = topology(prims, nodes, scratch, WIDTH, false)?;
     if leaves.len() < used_leaves {
         return Err(BuildError::Leaves(TooSmall {
             needed: used_leaves,
@@ -323,6 +323,7 @@ pub(crate) fn topology<P: Primitives + ?Sized>(
     nodes: &mut [Node],
     scratch: &mut [Scratch],
     width: usize,
+    threads: bool,
 ) -> Result<(usize, usize), BuildError> {
     let width = width.clamp(2, WIDTH);
     let n = prims.count();
@@ -354,16 +355,178 @@ pub(crate) fn topology<P: Primitives + ?Sized>(
         union(&mut b, &p.b);
         grow(&mut cb, &c, &c);
     }
-    let (mut used_nodes, mut used_leaves) = (1usize, 0usize);
-    // Pending nodes: a stack linked through their own slots, each holding its job until it
-    // is built (see `job`); `top` is the last pushed, NONE when empty.
-    let mut top = NONE;
     nodes[0] = Node::EMPTY;
-    if n > 0 {
-        nodes[0] = job([0, n as u32, 1, NONE], &b, &cb);
-        top = 0;
+    if n == 0 {
+        return Ok((1, 0));
     }
-    while top != NONE {
+    nodes[0] = job([0, n as u32, 1, NONE], &b, &cb);
+    // Below this many primitives, starting threads costs more than they save.
+    #[cfg(feature = "std")]
+    if threads && n >= 1 << 14 {
+        return threaded(nodes, s, width);
+    }
+    let _ = threads;
+    let g = expand(nodes, s, width, Grown::ROOT, usize::MAX)?;
+    Ok((g.nodes, g.leaves))
+}
+
+/// [`topology`] on every core (feature `std`): the root first, then the subtrees of its
+/// inner children, each over its own part of the scratch and into nodes of its own, on up to
+/// `available_parallelism` threads; then each subtree's nodes and leaf numbers are moved to
+/// where the one-thread build puts them (that build finishes the last child's subtree, then
+/// the one before: each subtree's nodes and leaves are a run of numbers). Every decision
+/// depends only on a node's range and depth, so the tree is the one-thread tree, bit for bit.
+#[cfg(feature = "std")]
+fn threaded(
+    nodes: &mut [Node],
+    s: &mut [Scratch],
+    width: usize,
+) -> Result<(usize, usize), BuildError> {
+    use std::sync::Mutex;
+    use std::vec::Vec;
+
+    let root = expand(nodes, s, width, Grown::ROOT, 1)?;
+    // The root's inner children, in the order the one-thread build takes them.
+    let mut kids = Vec::new();
+    let mut t = root.top;
+    while t != NONE {
+        let ([start, end, depth, next], b, cb) = unjob(&nodes[t as usize]);
+        kids.push((t, start, end, job([0, end - start, depth, NONE], &b, &cb)));
+        t = next;
+    }
+    let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
+    if cores < 2 || kids.len() < 2 {
+        let g = expand(nodes, s, width, root, usize::MAX)?;
+        return Ok((g.nodes, g.leaves));
+    }
+    // Each child's part of the scratch (disjoint ranges), the largest first.
+    let mut by_start: Vec<usize> = (0..kids.len()).collect();
+    by_start.sort_by_key(|&i| kids[i].1);
+    let mut work = Vec::with_capacity(kids.len());
+    let (mut rest, mut at) = (&mut *s, 0usize);
+    for i in by_start {
+        let (_, start, end, _) = kids[i];
+        let tail = core::mem::take(&mut rest);
+        let (_, tail) = tail.split_at_mut(start as usize - at);
+        let (part, tail) = tail.split_at_mut((end - start) as usize);
+        rest = tail;
+        at = end as usize;
+        work.push((i, part));
+    }
+    work.sort_by_key(|(_, part)| part.len());
+    let work = Mutex::new(work);
+    type Built = (usize, Result<(Vec<Node>, usize), BuildError>);
+    let built: Vec<Built> = std::thread::scope(|scope| {
+        let workers: Vec<_> = (0..cores.min(kids.len()))
+            .map(|_| {
+                scope.spawn(|| {
+                    let mut out: Vec<Built> = Vec::new();
+                    loop {
+                        let next = work.lock().map(|mut w| w.pop()).ok().flatten();
+                        let Some((i, part)) = next else { break };
+                        let mut local = std::vec![Node::EMPTY; sizes(part.len()).nodes];
+                        local[0] = kids[i].3;
+                        let g = expand(&mut local, part, width, Grown::ROOT, usize::MAX);
+                        out.push((
+                            i,
+                            g.map(|g| {
+                                local.truncate(g.nodes);
+                                (local, g.leaves)
+                            }),
+                        ));
+                    }
+                    out
+                })
+            })
+            .collect();
+        // `expand` does not panic; were a worker to, its panic is the caller's.
+        workers
+            .into_iter()
+            .flat_map(|w| w.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
+            .collect()
+    });
+    let mut subtrees: Vec<Option<(Vec<Node>, usize)>> = (0..kids.len()).map(|_| None).collect();
+    for (i, r) in built {
+        subtrees[i] = Some(r?);
+    }
+    // In the one-thread order: each subtree's nodes after the ones before, its root in the
+    // child's slot; its leaf numbers likewise (and in the marks `fill` reads).
+    let (mut base, mut leaf_base) = (root.nodes, root.leaves);
+    for (&(slot, start, end, _), sub) in kids.iter().zip(subtrees) {
+        let Some((local, leaves)) = sub else {
+            unreachable!("every child's subtree is built by a worker, whose panic is resumed");
+        };
+        let moved = |mut n: Node| {
+            for c in &mut n.child {
+                if *c == EMPTY {
+                } else if *c & LEAF != 0 {
+                    *c = LEAF | ((*c & !LEAF) + leaf_base as u32);
+                } else {
+                    *c = *c - 1 + base as u32;
+                }
+            }
+            n
+        };
+        let room = nodes
+            .get_mut(base..base + local.len() - 1)
+            .ok_or(BuildError::Nodes(TooSmall {
+                needed: base + local.len() - 1,
+            }))?;
+        for (to, &from) in room.iter_mut().zip(&local[1..]) {
+            *to = moved(from);
+        }
+        nodes[slot as usize] = moved(local[0]);
+        let part = &mut s[start as usize..end as usize];
+        let mut p = 0;
+        while let Some(first) = part.get_mut(p) {
+            let (id, size) = (first.c[0].to_bits(), first.c[1].to_bits() as usize);
+            first.c[0] = f32::from_bits(id + leaf_base as u32);
+            p += size.max(1);
+        }
+        base += local.len() - 1;
+        leaf_base += leaves;
+    }
+    Ok((base, leaf_base))
+}
+
+/// Where [`expand`] stands: nodes and leaves used so far, and the last pending node.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Grown {
+    pub(crate) nodes: usize,
+    pub(crate) leaves: usize,
+    /// The pending node built next (its job in its slot, linked to the next pending one), or
+    /// `NONE`.
+    pub(crate) top: u32,
+}
+
+impl Grown {
+    /// A subtree whose root's job is in slot 0 of its nodes.
+    pub(crate) const ROOT: Grown = Grown {
+        nodes: 1,
+        leaves: 0,
+        top: 0,
+    };
+}
+
+/// Builds up to `limit` pending nodes, last pushed first: each node's children are ranges of
+/// `s` (the job's range is relative to `s`); inner children get the next slots of `nodes`
+/// (with their jobs, pushed), leaves the next leaf numbers (their first entry marked for
+/// [`fill`]).
+pub(crate) fn expand(
+    nodes: &mut [Node],
+    s: &mut [Scratch],
+    width: usize,
+    from: Grown,
+    limit: usize,
+) -> Result<Grown, BuildError> {
+    let Grown {
+        nodes: mut used_nodes,
+        leaves: mut used_leaves,
+        mut top,
+    } = from;
+    let mut built = 0;
+    while top != NONE && built < limit {
+        built += 1;
         let node = top as usize;
         let ([start, end, depth, next], b, cb) = unjob(&nodes[node]);
         top = next;
@@ -447,7 +610,11 @@ pub(crate) fn topology<P: Primitives + ?Sized>(
         }
         nodes[node] = out;
     }
-    Ok((used_nodes, used_leaves))
+    Ok(Grown {
+        nodes: used_nodes,
+        leaves: used_leaves,
+        top,
+    })
 }
 
 /// The second pass of a build: writes each leaf from the primitives [`topology`] left in

@@ -663,3 +663,39 @@ fn instanced_scenes_equal_instance_by_instance() {
         }
     }
 }
+
+/// Nodes as bits.
+fn node_bits(n: &[Node]) -> Vec<u32> {
+    n.iter()
+        .flat_map(|n| {
+            n.bounds
+                .iter()
+                .flatten()
+                .map(|x| x.to_bits())
+                .chain(n.child)
+                .collect::<Vec<_>>()
+        })
+        .collect()
+}
+
+/// `OwnedBvh::new` builds on every core (feature `std`, which the tests turn on): the same
+/// nodes and leaves as the one-thread build over caller storage, bit for bit, and the same
+/// for the baked image (built the same way).
+#[test]
+fn the_threaded_build_is_the_one_thread_tree() {
+    let mut rng = SmallRng::seed_from_u64(21);
+    let m = crate::sets::bunny_visible_surface::load_bin(include_bytes!("../../data/bunny.bin"));
+    let bunny = Mesh::new(&m.pos, &m.idx);
+    let mut big = soup(&mut rng, 40_000);
+    // Coincident and degenerate triangles: ranges no plane splits, never-hit triangles.
+    big.extend(std::iter::repeat_n(big[7], 300));
+    big.push(Triangle::new(Vec3::ZERO, Vec3::ZERO, Vec3::X));
+    let check = |(nodes, leaves): (Vec<Node>, Vec<Tri4>), tree: bvh::OwnedBvh<Tri4>| {
+        let t = tree.view();
+        assert_eq!(node_bits(t.nodes()), node_bits(&nodes));
+        assert_eq!(leaf_bits(t.leaves()), leaf_bits(&leaves));
+        assert!(t.nodes().len() > 9, "{} nodes", t.nodes().len());
+    };
+    check(owned(&bunny), bvh::OwnedBvh::new(&bunny).unwrap());
+    check(owned(&big[..]), bvh::OwnedBvh::new(&big[..]).unwrap());
+}

@@ -55,7 +55,12 @@ fn check<L: Lane<Scalar = f32>, const W: usize, const H: usize>(
         let key = |h: &(u32, u32, Hit)| (h.1, h.0, h.2.t.to_bits(), h.2.index);
         all.sort_by_key(key);
         want_all.sort_by_key(key);
-        assert_eq!(all.len(), want_all.len(), "{} lanes, tile {x},{y}", L::LANES);
+        assert_eq!(
+            all.len(),
+            want_all.len(),
+            "{} lanes, tile {x},{y}",
+            L::LANES
+        );
         assert!(all == want_all, "{} lanes, tile {x},{y}", L::LANES);
     }
     hits
