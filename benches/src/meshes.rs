@@ -183,6 +183,29 @@ pub fn framing(centre: Vec3, radius: f32) -> Pinhole {
     Pinhole::look_at(centre + dir * dist, centre, Vec3::Y, FOV, WIDTH, HEIGHT)
 }
 
+/// The side of a camera tile in the primary workload ([`Workload::tiled`]).
+pub const TILE: u32 = 16;
+
+/// The pixels of `cam` in the order of [`Workload::tiled`] (the image's sides are multiples
+/// of [`TILE`]).
+pub fn tile_pixels(cam: &Pinhole) -> Vec<(u32, u32)> {
+    let mut v = Vec::with_capacity((cam.width * cam.height) as usize);
+    for ty in (0..cam.height).step_by(TILE as usize) {
+        for tx in (0..cam.width).step_by(TILE as usize) {
+            for by in (0..TILE).step_by(4) {
+                for bx in (0..TILE).step_by(4) {
+                    for j in 0..4 {
+                        for i in 0..4 {
+                            v.push((tx + bx + i, ty + by + j));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    v
+}
+
 /// The point light: up, right and in front of the scene, 3 radii from its centre.
 pub fn light(centre: Vec3, radius: f32) -> Vec3 {
     centre + Vec3::new(-1.0, 2.0, 1.5).normalize() * (3.0 * radius)
@@ -210,6 +233,16 @@ impl Workload {
     pub fn primary(cam: &Pinhole) -> Vec<Ray> {
         (0..cam.height)
             .flat_map(|y| (0..cam.width).map(move |x| crate::scene::pixel_ray(cam, x, y)))
+            .collect()
+    }
+
+    /// The camera's primary rays in tile order: tiles of [`TILE`]² pixels row by row, each in
+    /// blocks of 4 × 4 pixels row by row, each block row by row. Packets of 16 consecutive rays
+    /// are then 4 × 4 blocks and packets of 8 are 4 × 2 blocks, for every contender alike.
+    pub fn tiled(cam: &Pinhole) -> Vec<Ray> {
+        tile_pixels(cam)
+            .into_iter()
+            .map(|(x, y)| crate::scene::pixel_ray(cam, x, y))
             .collect()
     }
 
