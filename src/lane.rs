@@ -243,6 +243,19 @@ pub trait Lane:
     fn with_lane(self, i: usize, v: Self::Scalar) -> Self {
         Self::from_fn(|j| if j == i { v } else { self.lane(j) })
     }
+    /// The largest lane, as `f32` (for lanes without NaN; a comparison, not counted). The
+    /// traversal's packet bounds use it: halves compared as vectors where the lanes are one.
+    #[inline(always)]
+    fn max_lane(self) -> f32 {
+        let mut r = f32::NEG_INFINITY;
+        for i in 0..Self::LANES {
+            let v = self.lane(i).to_f64() as f32;
+            if v > r {
+                r = v;
+            }
+        }
+        r
+    }
 }
 
 /// Correctly rounded `f32` square root for the scalar lane.
@@ -437,7 +450,7 @@ impl Lane for f64 {
 /// Implements [`Mask`] and [`Lane`] for a `wide` f32 vector type: one macro, so the widths
 /// cannot drift apart.
 macro_rules! wide_lane {
-    ($t:ident, $n:literal) => {
+    ($t:ident, $n:literal, $max:ident) => {
         impl Mask for $t {
             #[inline(always)]
             fn splat(b: bool) -> Self {
@@ -544,13 +557,48 @@ macro_rules! wide_lane {
                 a[i] = v;
                 $t::new(a)
             }
+            #[inline(always)]
+            fn max_lane(self) -> f32 {
+                $max(self)
+            }
         }
     };
 }
 
-wide_lane!(f32x4, 4);
-wide_lane!(f32x8, 8);
-wide_lane!(f32x16, 16);
+/// The largest of 4 lanes: pairs, then the pair's maxima.
+#[inline(always)]
+fn max4(v: f32x4) -> f32 {
+    let a = v.to_array();
+    let (x, y) = (
+        if a[1] > a[0] { a[1] } else { a[0] },
+        if a[3] > a[2] { a[3] } else { a[2] },
+    );
+    if y > x { y } else { x }
+}
+
+/// The largest of 8 lanes: the halves' lane-wise maxima, then 4 lanes.
+#[inline(always)]
+fn max8(v: f32x8) -> f32 {
+    let a = v.to_array();
+    let (lo, hi) = (
+        f32x4::new([a[0], a[1], a[2], a[3]]),
+        f32x4::new([a[4], a[5], a[6], a[7]]),
+    );
+    max4(hi.simd_gt(lo).select(hi, lo))
+}
+
+/// The largest of 16 lanes: the halves' lane-wise maxima, then 8 lanes.
+#[inline(always)]
+fn max16(v: f32x16) -> f32 {
+    let a = v.to_array();
+    let lo = f32x8::new(core::array::from_fn(|i| a[i]));
+    let hi = f32x8::new(core::array::from_fn(|i| a[8 + i]));
+    max8(hi.simd_gt(lo).select(hi, lo))
+}
+
+wide_lane!(f32x4, 4, max4);
+wide_lane!(f32x8, 8, max8);
+wide_lane!(f32x16, 16, max16);
 
 /// `if mask { a } else { b }` for index arrays, lane by lane (only lanes set in `mask` change).
 #[inline(always)]

@@ -14,7 +14,7 @@ use glam::Vec3;
 use wide::{f32x4, f32x8, i32x4};
 
 use super::{EMPTY, MAX_DEPTH, STACK, WIDTH};
-use crate::lane::{Lane, Mask, Scalar};
+use crate::lane::{Lane, Mask};
 use crate::ray::RayPacket;
 
 /// A node layout (see the [module docs](self)).
@@ -653,12 +653,12 @@ impl<L: Lane> PacketSlab<L> {
 pub struct Frustum {
     near: [usize; 3],
     far: [usize; 3],
-    /// Per axis: the near origins' (min, max), the far origins' (min, max), the inverse
-    /// directions' (min, max), and whether they are negative.
-    on: [(f32, f32); 3],
-    of: [(f32, f32); 3],
+    /// Per axis: the near origin that gives the lowest entries (the highest with positive
+    /// directions, the lowest with negative ones), the far origin that gives the highest
+    /// exits, and the inverse directions' (min, max).
+    on: [f32; 3],
+    of: [f32; 3],
     inv: [(f32, f32); 3],
-    neg: [bool; 3],
 }
 
 impl Frustum {
@@ -668,33 +668,36 @@ impl Frustum {
         if (s.all & valid).any() || valid.none() {
             return None;
         }
+        // Lanes with a non-finite constant take the per-child test (the bounds skip NaN).
+        let mut finite = valid;
+        for a in 0..3 {
+            finite = finite & s.on[a].is_finite() & s.of[a].is_finite() & s.inv[a].is_finite();
+        }
+        if valid.and_not(finite).any() {
+            return None;
+        }
+        let hi = |x: L| highest(x, valid);
+        let lo = |x: L| -highest(-x, valid);
         let mut f = Frustum {
             near: [0, 1, 2],
             far: [3, 4, 5],
-            on: [(0.0, 0.0); 3],
-            of: [(0.0, 0.0); 3],
+            on: [0.0; 3],
+            of: [0.0; 3],
             inv: [(0.0, 0.0); 3],
-            neg: [false; 3],
         };
-        // Lanes with a non-finite constant take the per-child test (the ranges skip NaN).
-        let finite = |x: L| valid.and_not(x.is_finite()).none();
-        if !(0..3).all(|a| finite(s.on[a]) && finite(s.of[a]) && finite(s.inv[a])) {
-            return None;
-        }
-        let range = |x: L| (-highest(-x, valid), highest(x, valid));
         for a in 0..3 {
             let neg = s.neg[a] & valid;
             if neg.any() && valid.and_not(neg).any() {
                 return None;
             }
-            f.neg[a] = neg.any();
-            if f.neg[a] {
+            if neg.any() {
                 f.near[a] = 3 + a;
                 f.far[a] = a;
+                (f.on[a], f.of[a]) = (lo(s.on[a]), hi(s.of[a]));
+            } else {
+                (f.on[a], f.of[a]) = (hi(s.on[a]), lo(s.of[a]));
             }
-            f.on[a] = range(s.on[a]);
-            f.of[a] = range(s.of[a]);
-            f.inv[a] = range(s.inv[a]);
+            f.inv[a] = (lo(s.inv[a]), hi(s.inv[a]));
         }
         Some(f)
     }
@@ -709,12 +712,8 @@ impl Frustum {
         for a in 0..3 {
             let (near, far) = (f32x8::new(b[self.near[a]]), f32x8::new(b[self.far[a]]));
             let (vl, vh) = self.inv[a];
-            // The near planes' lowest and the far planes' highest offsets that matter.
-            let (x, y) = if self.neg[a] {
-                (near - self.on[a].0, far - self.of[a].1)
-            } else {
-                (near - self.on[a].1, far - self.of[a].0)
-            };
+            // The near planes' lowest and the far planes' highest offsets.
+            let (x, y) = (near - self.on[a], far - self.of[a]);
             tn = tn.fast_max((x * vl).fast_min(x * vh));
             tf = tf.fast_min((y * vl).fast_max(y * vh));
         }
@@ -725,15 +724,7 @@ impl Frustum {
 /// The highest value of the `valid` lanes (none NaN: valid rays have no NaN constants).
 #[inline(always)]
 pub(crate) fn highest<L: Lane>(t: L, valid: L::Mask) -> f32 {
-    let t = L::select(valid, t, L::from_f32(f32::NEG_INFINITY));
-    let mut r = f32::NEG_INFINITY;
-    for i in 0..L::LANES {
-        let v = t.lane(i).to_f64() as f32;
-        if v > r {
-            r = v;
-        }
-    }
-    r
+    L::select(valid, t, L::from_f32(f32::NEG_INFINITY)).max_lane()
 }
 
 #[cfg(test)]
