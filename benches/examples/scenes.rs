@@ -37,8 +37,9 @@ use std::time::Instant;
 
 use glam::Vec3;
 use raylane::bvh::bake::Baked;
-use raylane::bvh::{Bvh, Leaf};
-use raylane::{Pinhole, Ray, RayPacket};
+use raylane::bvh::{Bvh, Leaf, Tri4};
+use raylane::triangle::Moller;
+use raylane::{Pinhole, Query, Ray, RayPacket};
 use raylane_bench::bvh_peers::{
     EmbreeBvh, EmbreeRays, ObvhsBvh, ParryMesh, obvhs_rays, parry_rays,
 };
@@ -375,6 +376,51 @@ fn bvh_jobs<'a, P: Leaf + 'static>(
     }
 }
 
+/// The BVH with the Möller–Trumbore kernel instead of the watertight default (not watertight,
+/// as Embree's default triangle test is not): `tree.using::<Moller>()`, the same tree.
+fn moller_jobs<'a>(
+    shadow: bool,
+    all: &'a [Ray],
+    t: &'a Bvh<'a, Tri4>,
+    keep: &'a Keep,
+) -> Vec<Job<'a>> {
+    let b8: &Vec<RayPacket<f32x8>> = keep.put(rl::packets::<f32x8>(all));
+    let b16: &Vec<RayPacket<f32x16>> = keep.put(rl::packets::<f32x16>(all));
+    let (n, every) = (all.len(), (all.len(), true));
+    let m = move || t.using::<Moller>();
+    if shadow {
+        vec![
+            job(
+                "raylane BVH Möller any x8",
+                every,
+                move || rl::bvh_any(&m(), b8, n, None),
+                move || collect(|o| rl::bvh_any(&m(), b8, n, o)),
+            ),
+            job(
+                "raylane BVH Möller any x16",
+                every,
+                move || rl::bvh_any(&m(), b16, n, None),
+                move || collect(|o| rl::bvh_any(&m(), b16, n, o)),
+            ),
+        ]
+    } else {
+        vec![
+            job(
+                "raylane BVH Möller x1",
+                every,
+                move || rl::bvh_closest1(&m(), all, None),
+                move || collect(|o| rl::bvh_closest1(&m(), all, o)),
+            ),
+            job(
+                "raylane BVH Möller x16",
+                every,
+                move || rl::bvh_closest(&m(), b16, n, None),
+                move || collect(|o| rl::bvh_closest(&m(), b16, n, o)),
+            ),
+        ]
+    }
+}
+
 /// Camera tiles asked in one call (primary rays: `tree.closest(&cam.tile::<L, S, S>(x, y))`,
 /// 8 × 8 and 16 × 16 pixels in packets of 8 and 16, the rays made inside the call).
 fn tile_jobs<'a, P: Leaf + 'static>(
@@ -685,6 +731,7 @@ fn mesh_scene(res: &mut Results, m: &MeshData, opts: &Opts) {
             ));
         }
         jobs.extend(bvh_jobs(shadow, all, &tb, &keep));
+        jobs.extend(moller_jobs(shadow, all, &tb, &keep));
         jobs.extend(tile_jobs(kind, all, &tb, &w.cam));
         if let Some(bk) = opened.as_ref() {
             jobs.extend(baked_jobs(shadow, all, bk, &keep));
