@@ -14,6 +14,7 @@ use std::hint::black_box;
 use raylane::Query;
 use raylane::bvh::{OwnedBvh, Tri4};
 use raylane::mesh::Mesh;
+use raylane::triangle::Moller;
 use raylane_bench::bvh_peers::{EmbreeBvh, EmbreeRays};
 use raylane_bench::bvh_raylane as rl;
 use raylane_bench::meshes::{self, SurfaceHit, Workload};
@@ -86,6 +87,13 @@ fn measure() {
     run("primary raylane BVH tiles 16×16 x16", p.len(), &|| {
         rl::bvh_tiles::<f32x16, 16>(&tree, cam, (0, 1), None)
     });
+    let m = tree.using::<Moller>();
+    run("primary raylane BVH Möller x1", p.len(), &|| {
+        rl::bvh_closest1(&m, p, None)
+    });
+    run("primary raylane BVH Möller x16", p.len(), &|| {
+        rl::bvh_closest(&m, &p16, p.len(), None)
+    });
     run("primary raylane baked x1", p.len(), &|| {
         rl::bvh_closest1(&baked, p, None)
     });
@@ -102,6 +110,9 @@ fn measure() {
     run("diffuse raylane BVH x1", d.len(), &|| {
         rl::bvh_closest1(&tree, d, None)
     });
+    run("diffuse raylane BVH Möller x1", d.len(), &|| {
+        rl::bvh_closest1(&m, d, None)
+    });
     run("diffuse Embree rtcIntersect1", d.len(), &|| {
         ebr.intersect1(&ed, None)
     });
@@ -110,6 +121,9 @@ fn measure() {
     });
     run("shadow raylane BVH any x8", s.len(), &|| {
         rl::bvh_any(&tree, &s8, s.len(), None)
+    });
+    run("shadow raylane BVH Möller any x8", s.len(), &|| {
+        rl::bvh_any(&m, &s8, s.len(), None)
     });
     run("shadow Embree rtcOccluded1", s.len(), &|| {
         ebr.occluded1(&es, None)
