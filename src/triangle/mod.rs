@@ -204,14 +204,25 @@ impl<L: Lane> TrianglePacket<L> {
     #[must_use]
     pub fn from_fn(mut f: impl FnMut(usize) -> Triangle) -> Self {
         crate::lane::assert_fits::<L>();
-        let mut t = [Triangle::never(); crate::lane::MAX_LANES];
-        for (i, slot) in t.iter_mut().enumerate().take(L::LANES) {
-            *slot = f(i);
+        // The nine coordinates' lanes, written once per triangle, then read as vectors.
+        let mut c = [[0f32; crate::lane::MAX_LANES]; 9];
+        for i in 0..L::LANES {
+            let t = f(i);
+            for (k, v) in [t.a, t.b, t.c].into_iter().enumerate() {
+                c[3 * k][i] = v.x;
+                c[3 * k + 1][i] = v.y;
+                c[3 * k + 2][i] = v.z;
+            }
         }
+        let v = |k: usize| V3 {
+            x: L::from_f32_fn(|i| c[k][i]),
+            y: L::from_f32_fn(|i| c[k + 1][i]),
+            z: L::from_f32_fn(|i| c[k + 2][i]),
+        };
         TrianglePacket {
-            a: V3::from_fn(|i| t[i].a),
-            b: V3::from_fn(|i| t[i].b),
-            c: V3::from_fn(|i| t[i].c),
+            a: v(0),
+            b: v(3),
+            c: v(6),
         }
     }
 
