@@ -204,8 +204,10 @@ impl<L: Lane> TrianglePacket<L> {
     #[must_use]
     pub fn from_fn(mut f: impl FnMut(usize) -> Triangle) -> Self {
         crate::lane::assert_fits::<L>();
-        // The nine coordinates' lanes, written once per triangle, then read as vectors.
+        // The nine coordinates' lanes, written once per triangle, then read as vectors (rows
+        // of lanes: each vector one contiguous load).
         let mut c = [[0f32; crate::lane::MAX_LANES]; 9];
+        #[allow(clippy::needless_range_loop)] // `i` is the column of nine rows
         for i in 0..L::LANES {
             let t = f(i);
             for (k, v) in [t.a, t.b, t.c].into_iter().enumerate() {
