@@ -798,7 +798,7 @@ pub struct OwnedBvh<P: Packed> {
 impl<P: Packed> OwnedBvh<P> {
     /// Builds the tree over `prims` (a slice of triangles or spheres, a
     /// [`Mesh`](crate::mesh::Mesh)), keeping only the storage the build used. With feature
-    /// `std` it builds on every core (from 16,384 primitives): the same tree as one core's,
+    /// `std` it builds on every core (from 65,536 primitives): the same tree as one core's,
     /// bit for bit.
     ///
     /// # Errors

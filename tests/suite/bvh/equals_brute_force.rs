@@ -686,7 +686,7 @@ fn the_threaded_build_is_the_one_thread_tree() {
     let mut rng = SmallRng::seed_from_u64(21);
     let m = crate::sets::bunny_visible_surface::load_bin(include_bytes!("../../data/bunny.bin"));
     let bunny = Mesh::new(&m.pos, &m.idx);
-    let mut big = soup(&mut rng, 40_000);
+    let mut big = soup(&mut rng, 70_000);
     // Coincident and degenerate triangles: ranges no plane splits, never-hit triangles.
     big.extend(std::iter::repeat_n(big[7], 300));
     big.push(Triangle::new(Vec3::ZERO, Vec3::ZERO, Vec3::X));
