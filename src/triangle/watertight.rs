@@ -53,10 +53,6 @@ pub struct Shear<L: Lane> {
     kx: (L::Mask, L::Mask),
     ky: (L::Mask, L::Mask),
     kz: (L::Mask, L::Mask),
-    /// The permutation when every lane has the same (as `kz` and "kx, ky swapped"), so that a
-    /// triangle's vertices are permuted by moving whole vectors instead of selecting per lane:
-    /// the same values, bit for bit.
-    same: Option<(u8, bool)>,
     origin: V3<L>,
     sx: L,
     sy: L,
@@ -89,23 +85,11 @@ impl<L: Lane> Shear<L> {
         };
         let kx = either(ky0, kx0);
         let ky = either(kx0, ky0);
-        let uniform = |m: L::Mask| m.all() || m.none();
-        let same = (uniform(z_x) && uniform(z_y) && uniform(neg)).then(|| {
-            let kz = if z_x.test(0) {
-                0
-            } else if z_y.test(0) {
-                1
-            } else {
-                2
-            };
-            (kz, neg.test(0))
-        });
         // 4. The shear constants.
         let s = Shear {
             kx,
             ky,
             kz,
-            same,
             origin: ray.origin,
             sx: L::from_f32(0.0),
             sy: L::from_f32(0.0),
@@ -124,16 +108,7 @@ impl<L: Lane> Shear<L> {
     /// `(v[kx], v[ky], v[kz])` per lane.
     #[inline(always)]
     fn permute(&self, v: V3<L>) -> V3<L> {
-        match self.same {
-            // kz = x → (y, z, x), y → (z, x, y), z → (x, y, z); kx and ky swapped when d[kz] < 0.
-            Some((0, false)) => V3::new(v.y, v.z, v.x),
-            Some((0, true)) => V3::new(v.z, v.y, v.x),
-            Some((1, false)) => V3::new(v.z, v.x, v.y),
-            Some((1, true)) => V3::new(v.x, v.z, v.y),
-            Some((_, false)) => V3::new(v.x, v.y, v.z),
-            Some((_, true)) => V3::new(v.y, v.x, v.z),
-            None => V3::new(pick(self.kx, v), pick(self.ky, v), pick(self.kz, v)),
-        }
+        V3::new(pick(self.kx, v), pick(self.ky, v), pick(self.kz, v))
     }
 }
 
