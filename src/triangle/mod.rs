@@ -204,6 +204,15 @@ impl<L: Lane> TrianglePacket<L> {
     #[must_use]
     pub fn from_fn(mut f: impl FnMut(usize) -> Triangle) -> Self {
         crate::lane::assert_fits::<L>();
+        if L::LANES == 1 {
+            // One lane: the triangle itself (no rows to fill).
+            let t = f(0);
+            return TrianglePacket {
+                a: V3::splat(t.a),
+                b: V3::splat(t.b),
+                c: V3::splat(t.c),
+            };
+        }
         // The nine coordinates' lanes, written once per triangle, then read as vectors (rows
         // of lanes: each vector one contiguous load).
         let mut c = [[0f32; crate::lane::MAX_LANES]; 9];
