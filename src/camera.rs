@@ -117,8 +117,8 @@ impl Pinhole {
     /// Pixels `(x + i mod w, y + i div w)` in lane `i` (see [`row_packet`](Self::row_packet)).
     fn packet<L: Lane>(&self, x: u32, y: u32, w: usize) -> RayPacket<L> {
         // Column and row of lane i, in u64 so that they cannot wrap (x, y ≤ u32::MAX, i < 2^32).
-        let col = |i: usize| u64::from(x) + (i % w) as u64;
-        let row = |i: usize| u64::from(y) + (i / w) as u64;
+        let col = |i: usize| u64::from(x) + offset(i, w).0 as u64;
+        let row = |i: usize| u64::from(y) + offset(i, w).1 as u64;
         let px = L::from_f32_fn(|i| col(i) as f32 + 0.5);
         let py = L::from_f32_fn(|i| row(i) as f32 + 0.5);
         let corner = V3::<L>::splat(self.corner);
@@ -145,6 +145,17 @@ pub const fn block<L: Lane>() -> (usize, usize) {
         w *= 2;
     }
     (w, L::LANES / w)
+}
+
+/// Lane `i`'s pixel in a block of `L` ([`block`]): `(i mod w, i div w)`.
+#[must_use]
+pub const fn block_lane<L: Lane>(i: usize) -> (usize, usize) {
+    offset(i, block::<L>().0)
+}
+
+/// Lane `i`'s pixel in a packet `w` pixels wide.
+const fn offset(i: usize, w: usize) -> (usize, usize) {
+    (i % w, i / w)
 }
 
 /// A camera tile: `W × H` pixels from `(x, y)` of a [`Pinhole`] ([`Pinhole::tile`]), asked as

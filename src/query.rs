@@ -62,7 +62,7 @@
 //! `|d|²` differs from 1 by more than `2^-20` is a miss for them (a documented answer, never
 //! wrong roots); normalise directions first ([`Dir`](crate::Dir)).
 
-use crate::camera::{Tile, block};
+use crate::camera::{Tile, block_lane};
 use crate::hit::{All, Any, Closest, Hit, Hits};
 use crate::kernel::{Cull, Kernel};
 use crate::lane::{Lane, Mask};
@@ -209,7 +209,8 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
         for (dx, dy, rays) in tile.packets() {
             let hits = RayPacket::closest(t, &rays);
             for i in 0..L::LANES {
-                out[dy + i / block::<L>().0][dx + i % block::<L>().0] = hits.lane(i);
+                let (px, py) = block_lane::<L>(i);
+                out[dy + py][dx + px] = hits.lane(i);
             }
         }
         out
@@ -221,7 +222,8 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
         for (dx, dy, rays) in tile.packets() {
             let hit = RayPacket::any(t, &rays);
             for i in 0..L::LANES {
-                out[dy + i / block::<L>().0][dx + i % block::<L>().0] = hit.test(i);
+                let (px, py) = block_lane::<L>(i);
+                out[dy + py][dx + px] = hit.test(i);
             }
         }
         out
@@ -234,8 +236,8 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
             RayPacket::all(t, &rays, &mut |h: Hits<L>| {
                 for i in 0..L::LANES {
                     if let Some(hit) = h.lane(i) {
-                        let (px, py) = (dx + i % block::<L>().0, dy + i / block::<L>().0);
-                        f((x + px as u32, y + py as u32, hit));
+                        let (px, py) = block_lane::<L>(i);
+                        f((x + (dx + px) as u32, y + (dy + py) as u32, hit));
                     }
                 }
             });

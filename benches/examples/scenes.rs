@@ -39,7 +39,7 @@ use glam::Vec3;
 use raylane::bvh::bake::Baked;
 use raylane::bvh::{Bvh, Leaf, Tri4};
 use raylane::triangle::Moller;
-use raylane::{Pinhole, Query, Ray, RayPacket};
+use raylane::{Lane, Pinhole, Query, Ray, RayPacket};
 use raylane_bench::bvh_peers::{
     EmbreeBvh, EmbreeRays, ObvhsBvh, ParryMesh, obvhs_rays, parry_rays,
 };
@@ -432,33 +432,26 @@ fn tile_jobs<'a, P: Leaf + 'static>(
     if kind != Kind::Primary {
         return Vec::new();
     }
-    let every = (all.len(), true);
     vec![
-        job(
-            "raylane BVH tiles 8×8 x8",
-            every,
-            move || rl::bvh_tiles::<f32x8, 8>(t, cam, (0, 1), None),
-            move || collect(|o| rl::bvh_tiles::<f32x8, 8>(t, cam, (0, 1), o)),
-        ),
-        job(
-            "raylane BVH tiles 16×16 x8",
-            every,
-            move || rl::bvh_tiles::<f32x8, 16>(t, cam, (0, 1), None),
-            move || collect(|o| rl::bvh_tiles::<f32x8, 16>(t, cam, (0, 1), o)),
-        ),
-        job(
-            "raylane BVH tiles 8×8 x16",
-            every,
-            move || rl::bvh_tiles::<f32x16, 8>(t, cam, (0, 1), None),
-            move || collect(|o| rl::bvh_tiles::<f32x16, 8>(t, cam, (0, 1), o)),
-        ),
-        job(
-            "raylane BVH tiles 16×16 x16",
-            every,
-            move || rl::bvh_tiles::<f32x16, 16>(t, cam, (0, 1), None),
-            move || collect(|o| rl::bvh_tiles::<f32x16, 16>(t, cam, (0, 1), o)),
-        ),
+        tile_job::<f32x8, 8, P>(all.len(), t, cam),
+        tile_job::<f32x8, 16, P>(all.len(), t, cam),
+        tile_job::<f32x16, 8, P>(all.len(), t, cam),
+        tile_job::<f32x16, 16, P>(all.len(), t, cam),
     ]
+}
+
+/// The camera's tiles of `S × S` pixels in packets of `L`, each tile one call.
+fn tile_job<'a, L: Lane<Scalar = f32>, const S: usize, P: Leaf + 'static>(
+    rays: usize,
+    t: &'a Bvh<'a, P>,
+    cam: &'a Pinhole,
+) -> Job<'a> {
+    job(
+        format!("raylane BVH tiles {S}×{S} x{}", L::LANES),
+        (rays, true),
+        move || rl::bvh_tiles::<L, S>(t, cam, (0, 1), None),
+        move || collect(|o| rl::bvh_tiles::<L, S>(t, cam, (0, 1), o)),
+    )
 }
 
 /// Frames of one kind of ray traced by `f(first, step)` (every `step`-th tile or chunk from

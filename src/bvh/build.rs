@@ -417,7 +417,7 @@ fn threaded(
     work.sort_by_key(|(_, part)| part.len());
     let work = Mutex::new(work);
     type Built = (usize, Result<(Vec<Node>, usize), BuildError>);
-    let built: Vec<Built> = std::thread::scope(|scope| {
+    let mut built: Vec<Built> = std::thread::scope(|scope| {
         let workers: Vec<_> = (0..cores.min(kids.len()))
             .map(|_| {
                 scope.spawn(|| {
@@ -446,17 +446,13 @@ fn threaded(
             .flat_map(|w| w.join().unwrap_or_else(|p| std::panic::resume_unwind(p)))
             .collect()
     });
-    let mut subtrees: Vec<Option<(Vec<Node>, usize)>> = (0..kids.len()).map(|_| None).collect();
-    for (i, r) in built {
-        subtrees[i] = Some(r?);
-    }
+    // Every child was taken by exactly one worker: in the children's order again.
+    built.sort_by_key(|&(i, _)| i);
     // In the one-thread order: each subtree's nodes after the ones before, its root in the
     // child's slot; its leaf numbers likewise (and in the marks `fill` reads).
     let (mut base, mut leaf_base) = (root.nodes, root.leaves);
-    for (&(slot, start, end, _), sub) in kids.iter().zip(subtrees) {
-        let Some((local, leaves)) = sub else {
-            unreachable!("every child's subtree is built by a worker, whose panic is resumed");
-        };
+    for (&(slot, start, end, _), (_, sub)) in kids.iter().zip(built) {
+        let (local, leaves) = sub?;
         let moved = |mut n: Node| {
             for c in &mut n.child {
                 if *c == EMPTY {
@@ -478,11 +474,9 @@ fn threaded(
         }
         nodes[slot as usize] = moved(local[0]);
         let part = &mut s[start as usize..end as usize];
-        let mut p = 0;
-        while let Some(first) = part.get_mut(p) {
-            let (id, size) = (first.c[0].to_bits(), first.c[1].to_bits() as usize);
-            first.c[0] = f32::from_bits(id + leaf_base as u32);
-            p += size.max(1);
+        let marked: Vec<(usize, u32, u32)> = runs(part).collect();
+        for (p, id, size) in marked {
+            mark(&mut part[p], id + leaf_base as u32, size);
         }
         base += local.len() - 1;
         leaf_base += leaves;
@@ -590,11 +584,7 @@ pub(crate) fn expand(
                 out.bounds[3 + axis][k] = hi[axis];
             }
             if (b - a) as usize <= LEAF_WIDTH {
-                // The leaf's range is final: its first entry's centroid (no longer read)
-                // keeps the leaf's number and size for `fill`.
-                let first = &mut s[a as usize];
-                first.c[0] = f32::from_bits(used_leaves as u32);
-                first.c[1] = f32::from_bits(b - a);
+                mark(&mut s[a as usize], used_leaves as u32, b - a);
                 out.child[k] = LEAF | used_leaves as u32;
                 used_leaves += 1;
             } else {
@@ -621,18 +611,35 @@ pub(crate) fn expand(
 /// The second pass of a build: writes each leaf from the primitives [`topology`] left in
 /// `s` (every leaf a run of entries, the first marked with its number and size).
 pub(crate) fn fill<P: Primitives + ?Sized>(prims: &P, s: &[Scratch], leaves: &mut [P::Leaf]) {
-    let mut p = 0;
-    while let Some(first) = s.get(p) {
-        let (id, size) = (first.c[0].to_bits() as usize, first.c[1].to_bits() as usize);
-        let (Some(slot), Some(run)) = (leaves.get_mut(id), s.get(p..p + size)) else {
+    for (p, id, size) in runs(s) {
+        let (Some(slot), Some(run)) = (leaves.get_mut(id as usize), s.get(p..p + size as usize))
+        else {
             return;
         };
         *slot = P::Leaf::EMPTY;
         for (lane, q) in run.iter().enumerate() {
             prims.put(q.index, slot, lane);
         }
-        p += size.max(1);
     }
+}
+
+/// Marks `first` as the first entry of leaf `id` of `size` primitives: a leaf's range is final
+/// once made, so its first centroid (no longer read) can hold the two.
+fn mark(first: &mut Scratch, id: u32, size: u32) {
+    first.c[0] = f32::from_bits(id);
+    first.c[1] = f32::from_bits(size);
+}
+
+/// The leaves [`mark`]ed in `s`, in order: (first entry, leaf number, size).
+fn runs(s: &[Scratch]) -> impl Iterator<Item = (usize, u32, u32)> + '_ {
+    let mut p = 0;
+    core::iter::from_fn(move || {
+        let first = s.get(p)?;
+        let (id, size) = (first.c[0].to_bits(), first.c[1].to_bits());
+        let at = p;
+        p += (size as usize).max(1);
+        Some((at, id, size))
+    })
 }
 
 /// [`Bvh::refit`].
