@@ -182,8 +182,16 @@ fn many_with<S: Entries, N: Layout, L: Lane, C: Collector<L>>(
         ..*rays
     };
     let mut fr = frustum(&slab, &r, valid);
-    let one_eye = fr.as_ref().is_some_and(|f| f.one_eye);
-    let split = if one_eye { 0 } else { split };
+    // A camera's packet never splits (its frustum is tight down to the leaves); one whose
+    // directions' signs differ (no frustum: every child is tested lane by lane) splits at
+    // twice `split` (diffuse rays on a 940k-triangle mesh: packets of 8 from 0.75× to 0.86×
+    // Embree's one-ray speed, of 16 from 0.83× to 0.93×; twice `split` for frustum packets
+    // cost shadow rays 1.07× → 0.96× on a 69k one).
+    let split = match &fr {
+        Some(f) if f.one_eye => 0,
+        Some(_) => split,
+        None => (2 * split).min(L::LANES as u32),
+    };
     let mut stack = S::new();
     stack.push(0, valid.bits());
     while let Some((n, lanes)) = stack.pop() {
