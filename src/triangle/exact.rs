@@ -238,16 +238,13 @@ pub(crate) fn collinear(a: [f64; 3], b: [f64; 3], c: [f64; 3]) -> bool {
     let [ax, ay, az] = a;
     let [bx, by, bz] = b;
     let [cx, cy, cz] = c;
-    [
-        (ay, az, by, bz, cy, cz),
-        (az, ax, bz, bx, cz, cx),
-        (ax, ay, bx, by, cx, cy),
-    ]
-    .into_iter()
-    .all(|(aj, ak, bj, bk, cj, ck)| component_is_zero(aj, ak, bj, bk, cj, ck))
+    component_is_zero(ay, az, by, bz, cy, cz)
+        && component_is_zero(az, ax, bz, bx, cz, cx)
+        && component_is_zero(ax, ay, bx, by, cx, cy)
 }
 
 /// True when `(b_j − a_j)(c_k − a_k) − (b_k − a_k)(c_j − a_j)` is exactly zero.
+#[inline(always)]
 fn component_is_zero(aj: f64, ak: f64, bj: f64, bk: f64, cj: f64, ck: f64) -> bool {
     const TOL: f64 = 8.0 / 9_007_199_254_740_992.0; // 8·2^-53
     let (p, q) = (bj - aj, ck - ak);
@@ -256,6 +253,14 @@ fn component_is_zero(aj: f64, ak: f64, bj: f64, bk: f64, cj: f64, ck: f64) -> bo
     if approx.abs() > TOL * ((p * q).abs() + (r * s).abs()) {
         return false;
     }
+    exactly_zero(aj, ak, bj, bk, cj, ck)
+}
+
+/// [`component_is_zero`] when the filter cannot decide (out of line: a build's triangles
+/// almost never need it).
+#[cold]
+#[inline(never)]
+fn exactly_zero(aj: f64, ak: f64, bj: f64, bk: f64, cj: f64, ck: f64) -> bool {
     // Exactly: b_j c_k − b_j a_k − a_j c_k − b_k c_j + b_k a_j + a_k c_j (the a_j a_k terms
     // cancel).
     let mut x = Expansion::<16>::new();
