@@ -597,9 +597,10 @@ impl<P: Leaf, N: Layout> Bvh<'_, P, N> {
 }
 
 /// Lanes at or below which a packet's subtree continues lane by lane as single rays (`0`:
-/// never): for plain `f32` packets and collectors that keep one hit per lane (closest, any).
-/// Measured on the bunny and its subdivisions (`benches/examples/scenes.rs`): see
-/// `docs/benchmarks.md`.
+/// never): for plain `f32` packets and collectors that keep one hit per lane (closest, any);
+/// a quarter of the lanes, twice that for packets whose directions' signs differ (see
+/// `traverse::many`). Measured on the bunny and its subdivisions
+/// (`benches/examples/scenes.rs`): see `docs/benchmarks.md`.
 #[inline(always)]
 pub(crate) const fn split<L: Lane, C: Collector<L>>() -> u32 {
     if L::PLAIN_F32 && !C::EVERY && L::LANES > 1 {
