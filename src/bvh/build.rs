@@ -185,36 +185,40 @@ fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, Boxes, Boxes)> {
             continue;
         }
         let (count, boxes) = (&count[axis], &boxes[axis]);
-        // Sweep: right-side areas and counts from the top, then left sides upward. Empty bins
-        // change nothing: the plane after one costs what the plane before it costs (which
-        // wins the tie), so they are skipped.
+        // Sweeps over the non-empty bins only: an empty bin changes nothing (the plane after
+        // it costs what the plane before it costs, which wins the tie). Right sides from the
+        // top (the bins from `j` up, stored at each non-empty `j ≥ 1`), then left sides
+        // upward, each plane after a non-empty bin `i` against the right side from the next
+        // non-empty bin `j`.
+        let mut used = 0u32;
+        for (i, &c) in count.iter().enumerate() {
+            used |= u32::from(c != 0) << i;
+        }
         let mut right_area = [0.0f32; BINS];
         let mut right_count = [0u32; BINS];
-        let mut acc = EMPTY_LANES;
-        let (mut n, mut a) = (0, 0.0);
-        for i in (1..BINS).rev() {
-            if count[i] != 0 {
-                union(&mut acc, &boxes[i]);
-                n += count[i];
-                a = lanes_area(&acc);
-            }
-            right_area[i] = a;
-            right_count[i] = n;
+        let (mut acc, mut n) = (EMPTY_LANES, 0);
+        let mut top = used & !1;
+        while top != 0 {
+            let j = (31 - top.leading_zeros()) as usize;
+            top &= !(1 << j);
+            union(&mut acc, &boxes[j]);
+            n += count[j];
+            right_area[j] = lanes_area(&acc);
+            right_count[j] = n;
         }
-        let mut acc = EMPTY_LANES;
-        let mut n = 0;
-        for i in 0..BINS - 1 {
-            let nr = right_count[i + 1];
-            if nr == 0 {
+        let (mut acc, mut n) = (EMPTY_LANES, 0);
+        let mut rest = used;
+        while rest != 0 {
+            let i = rest.trailing_zeros() as usize;
+            rest &= rest - 1;
+            if rest == 0 {
                 break;
             }
-            if count[i] == 0 {
-                continue;
-            }
+            let j = rest.trailing_zeros() as usize;
             union(&mut acc, &boxes[i]);
             n += count[i];
             // Primitives count in whole leaves (Embree's blocks): a side of 5 costs as 8.
-            let cost = lanes_area(&acc) * blocks(n) + right_area[i + 1] * blocks(nr);
+            let cost = lanes_area(&acc) * blocks(n) + right_area[j] * blocks(right_count[j]);
             if best.is_none_or(|b| cost < b.0) {
                 best = Some((cost, axis, i));
             }
