@@ -260,7 +260,7 @@ impl Primitives for Mesh<'_> {
     }
     fn put(&self, i: u32, leaf: &mut Tri4, k: usize) {
         // As the mesh checked it when made (`Triangle::new`'s bits, without its exact test
-        // again: 8 % of a build).
+        // again: about 3 % of a build).
         let t = self.prepared(i as usize);
         leaf.set_triangle(k, &t, i);
     }

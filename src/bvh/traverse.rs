@@ -32,12 +32,12 @@ fn push_sorted<N: Layout, S: Entries>(
     tn: &[f32; WIDTH],
     key: impl Fn(usize) -> u32,
 ) -> Option<(u32, u32)> {
-    // One or two children (most nodes a ray enters) without the sort's loops: the same order.
-    let first = bits.trailing_zeros() as usize;
-    let rest = bits & bits.wrapping_sub(1);
     if bits == 0 {
         return None;
     }
+    // One or two children (most nodes a ray enters) without the sort's loops: the same order.
+    let first = bits.trailing_zeros() as usize;
+    let rest = bits & (bits - 1);
     if rest == 0 {
         return Some((n.child(first), key(first)));
     }
