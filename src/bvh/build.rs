@@ -491,9 +491,13 @@ fn threaded(
         }
         nodes[slot as usize] = moved(local[0]);
         let part = &mut s[start as usize..end as usize];
-        let marked: Vec<(usize, u32, u32)> = runs(part).collect();
-        for (p, id, size) in marked {
-            mark(&mut part[p], id + leaf_base as u32, size);
+        // Each leaf's mark renumbered in place (the run's first entry is at 0).
+        let mut p = 0;
+        while let Some((_, id, size)) = part.get(p..).and_then(|r| runs(r).next()) {
+            if let Some(first) = part.get_mut(p) {
+                mark(first, id + leaf_base as u32, size);
+            }
+            p += (size as usize).max(1);
         }
         base += local.len() - 1;
         leaf_base += leaves;
