@@ -525,7 +525,7 @@ impl Set for Baked<'_> {
             self.reach,
             &rays,
             c,
-            |r_leaf, r, c| {
+            |r_leaf, r, _, c| {
                 let (first, count) = Self::leaf(r_leaf);
                 let mut r = *r;
                 for t in first..first + count {

@@ -38,6 +38,9 @@ pub trait Leaf: Packed {
     fn splat<L: Lane>(&self, k: usize) -> <Self::Prim as Primitive>::Packet<L>;
     /// The leaf's primitives in `f32x4` lanes (1 ray × 4 primitives).
     fn four(&self) -> <Self::Prim as Primitive>::Packet<f32x4>;
+    /// The boxes of the lanes' primitives that can be hit, as [`Packed::bounds`] gives them
+    /// (rows minimum x, y, z, maximum x, y, z; a primitive per lane), for a packet's cull.
+    fn boxes(&self) -> [f32x4; 6];
 }
 
 /// A set of primitives a tree can be built over.
@@ -171,6 +174,22 @@ impl Leaf for Tri4 {
             c: lanes4(&self.c),
         }
     }
+
+    #[inline(always)]
+    fn boxes(&self) -> [f32x4; 6] {
+        // As `bounds` for every triangle that can be hit (no NaN vertex).
+        let (a, b, c) = (lanes4(&self.a), lanes4(&self.b), lanes4(&self.c));
+        let lo = |a: f32x4, b: f32x4, c: f32x4| a.fast_min(b).fast_min(c);
+        let hi = |a: f32x4, b: f32x4, c: f32x4| a.fast_max(b).fast_max(c);
+        [
+            lo(a.x, b.x, c.x),
+            lo(a.y, b.y, c.y),
+            lo(a.z, b.z, c.z),
+            hi(a.x, b.x, c.x),
+            hi(a.y, b.y, c.y),
+            hi(a.z, b.z, c.z),
+        ]
+    }
 }
 
 impl Packed for Sphere4 {
@@ -213,6 +232,13 @@ impl Leaf for Sphere4 {
             center: lanes4(&self.center),
             radius: f32x4::new(self.radius),
         }
+    }
+
+    #[inline(always)]
+    fn boxes(&self) -> [f32x4; 6] {
+        // As `bounds` for every valid sphere (finite radius).
+        let (c, r) = (lanes4(&self.center), f32x4::new(self.radius));
+        [c.x - r, c.y - r, c.z - r, c.x + r, c.y + r, c.z + r]
     }
 }
 

@@ -109,7 +109,9 @@
 //!    costs nothing per node: it is folded into two origins per ray (`o ± m` per axis, by the
 //!    sign of `d`). A zero direction component gives a `±2^100` inverse (never NaN), and rays
 //!    whose `|d|∞` lies outside `2^-64…2^64` or whose `R + |o|∞` exceeds `2^100` visit every
-//!    non-empty child (still exact, only slower).
+//!    non-empty child (still exact, only slower). The argument is per primitive's box, so a
+//!    packet with a frustum also tests the boxes of a leaf's primitives (`Leaf::boxes`, as
+//!    the builder bounds them) before their kernels run: a pure prune as well.
 //!
 //! The interval is decided by the collector alone — a hit counts when its rounded `t` lies in
 //! `(t_min, t_max)` — so the tree and brute force agree for every `t_max`, finite or not, and
@@ -648,7 +650,9 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
             self.reach,
             &rays,
             c,
-            |li, r, c| leaf_many::<P, K, L, C>(self.leaves, li, &rays, r, &pre, cull, set, c),
+            |li, r, cone, c| {
+                leaf_many::<P, K, L, C>(self.leaves, li, &rays, r, cone, &pre, cull, set, c)
+            },
             split::<L, C>(),
             |start, i, c| {
                 alone(c, i, |one| {
@@ -691,7 +695,13 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
 }
 
 /// The primitives of leaf `li` against a packet: N rays × 1 primitive per lane of the leaf,
-/// in order, each offered to `c`.
+/// in order, each offered to `c`. With the packet's `cone`, only the primitives whose boxes
+/// it may enter (one `f32x4` interval test for the four; a pure prune, see the module docs):
+/// in a camera's 4 × 4 blocks a leaf's box is met far more often than each of its triangles'
+/// (callgrind, x86-64-v3, the vendored bunny: 348 → 285 instructions per primary ray in
+/// packets of 16, 377 → 337 in packets of 8, shadow packets of 8 510 → 471; time on the
+/// benchmark's AVX-512 build within the noise, on a default SSE2 build primary packets of 16
+/// 1.18–1.39× faster).
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn leaf_many<P: Leaf, K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
@@ -699,6 +709,7 @@ pub(crate) fn leaf_many<P: Leaf, K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
     li: u32,
     rays: &RayPacket<L>,
     r: &RayPacket<L>,
+    cone: Option<&traverse::Cone>,
     pre: &K::Rays<L>,
     cull: Cull,
     set: u32,
@@ -707,9 +718,10 @@ pub(crate) fn leaf_many<P: Leaf, K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
     let Some(leaf) = leaves.get(li as usize) else {
         return false;
     };
+    let keep = cone.map_or(u32::MAX, |f| f.enters(leaf.boxes()));
     let mut r = *r;
     for (k, &index) in leaf.indices().iter().enumerate() {
-        if index == EMPTY {
+        if index == EMPTY || keep & (1 << k) == 0 {
             continue;
         }
         r.t_max = c.t_max();

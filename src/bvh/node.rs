@@ -707,19 +707,68 @@ impl Frustum {
     /// parameters.
     #[inline(always)]
     pub fn test(&self, b: &[[f32; WIDTH]; 6], t_lo: f32, t_hi: f32) -> (u32, [f32; WIDTH]) {
-        let mut tn = f32x8::splat(t_lo);
-        let mut tf = f32x8::splat(t_hi);
+        let (bits, tn) = self.test_rows(|r| f32x8::new(b[r]), t_lo, t_hi);
+        (bits, tn.to_array())
+    }
+
+    /// [`Frustum::test`] on the boxes of a leaf's four primitives (minimum x, y, z, maximum
+    /// x, y, z, a primitive per lane): bit `k` set when some lane may enter box `k`.
+    #[inline(always)]
+    pub fn test4(&self, b: [f32x4; 6], t_lo: f32, t_hi: f32) -> u32 {
+        self.test_rows(|r| b[r], t_lo, t_hi).0
+    }
+
+    /// The interval test of [`Frustum::test`], a box per lane of `R` (`b(r)`: row `r`).
+    #[inline(always)]
+    fn test_rows<R: Row>(&self, b: impl Fn(usize) -> R, t_lo: f32, t_hi: f32) -> (u32, R) {
+        let mut tn = R::splat(t_lo);
+        let mut tf = R::splat(t_hi);
         for a in 0..3 {
-            let (near, far) = (f32x8::new(b[self.near[a]]), f32x8::new(b[self.far[a]]));
-            let (vl, vh) = self.inv[a];
+            let (near, far) = (b(self.near[a]), b(self.far[a]));
+            let (vl, vh) = (R::splat(self.inv[a].0), R::splat(self.inv[a].1));
             // The near planes' lowest and the far planes' highest offsets.
-            let (x, y) = (near - self.on[a], far - self.of[a]);
-            tn = tn.fast_max((x * vl).fast_min(x * vh));
-            tf = tf.fast_min((y * vl).fast_max(y * vh));
+            let (x, y) = (near - R::splat(self.on[a]), far - R::splat(self.of[a]));
+            tn = tn.max((x * vl).min(x * vh));
+            tf = tf.min((y * vl).max(y * vh));
         }
-        (tn.simd_le(tf).to_bitmask(), tn.to_array())
+        (tn.le_bits(tf), tn)
     }
 }
+
+/// The `wide` vectors the frustum test runs on: a node's 8 children, a leaf's 4 primitives.
+trait Row: Copy + core::ops::Sub<Output = Self> + core::ops::Mul<Output = Self> {
+    fn splat(x: f32) -> Self;
+    /// Lane-wise minimum and maximum (either operand where one is NaN).
+    fn min(self, o: Self) -> Self;
+    fn max(self, o: Self) -> Self;
+    /// Bit `k` set where lane `k` of `self` is at most `o`'s.
+    fn le_bits(self, o: Self) -> u32;
+}
+
+macro_rules! row {
+    ($t:ty) => {
+        impl Row for $t {
+            #[inline(always)]
+            fn splat(x: f32) -> Self {
+                <$t>::splat(x)
+            }
+            #[inline(always)]
+            fn min(self, o: Self) -> Self {
+                self.fast_min(o)
+            }
+            #[inline(always)]
+            fn max(self, o: Self) -> Self {
+                self.fast_max(o)
+            }
+            #[inline(always)]
+            fn le_bits(self, o: Self) -> u32 {
+                self.simd_le(o).to_bitmask() as u32
+            }
+        }
+    };
+}
+row!(f32x4);
+row!(f32x8);
 
 /// The highest value of the `valid` lanes (none NaN: valid rays have no NaN constants).
 #[inline(always)]

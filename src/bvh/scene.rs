@@ -318,7 +318,7 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
             self.top.reach,
             rays,
             c,
-            |li, r, c| {
+            |li, r, _, c| {
                 let Some(leaf) = self.top.leaves.get(li as usize) else {
                     return false;
                 };

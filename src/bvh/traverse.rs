@@ -5,7 +5,9 @@
 //! what happens at a leaf (a closure: kernels over primitives, or instances traversed in turn).
 //!
 //! A leaf closure offers its candidates to the collector and returns true when the collector
-//! asked to stop; the loops read the collector's `t_max` to prune. A one-ray traversal whose
+//! asked to stop; the loops read the collector's `t_max` to prune. A packet's leaf closure
+//! also gets the packet's [`Cone`] (where it has one), to skip the primitives whose boxes no
+//! lane may enter. A one-ray traversal whose
 //! short stack overflows runs again with the full one (keeping what the collector found: a
 //! closest hit found is still a candidate, and `any` had found nothing), except for
 //! collectors that report every hit, which start with the full stack.
@@ -161,7 +163,7 @@ pub(crate) fn many<N: Layout, L: Lane, C: Collector<L>>(
     reach: f32,
     rays: &RayPacket<L>,
     c: &mut C,
-    mut leaf: impl FnMut(u32, &RayPacket<L>, &mut C) -> bool,
+    mut leaf: impl FnMut(u32, &RayPacket<L>, Option<&Cone>, &mut C) -> bool,
     split: u32,
     mut single: impl FnMut(u32, usize, &mut C) -> bool,
 ) -> bool {
@@ -186,7 +188,7 @@ fn many_with<S: Entries, N: Layout, L: Lane, C: Collector<L>>(
     reach: f32,
     rays: &RayPacket<L>,
     c: &mut C,
-    leaf: &mut impl FnMut(u32, &RayPacket<L>, &mut C) -> bool,
+    leaf: &mut impl FnMut(u32, &RayPacket<L>, Option<&Cone>, &mut C) -> bool,
     split: u32,
     single: &mut impl FnMut(u32, usize, &mut C) -> bool,
 ) -> Option<bool> {
@@ -237,7 +239,7 @@ fn many_with<S: Entries, N: Layout, L: Lane, C: Collector<L>>(
             }
             continue;
         }
-        if leaf(n & !LEAF, &r, c) {
+        if leaf(n & !LEAF, &r, fr.as_ref(), c) {
             return Some(true);
         }
         // Shrink the intervals (and the frustum's) to the collector's.
@@ -266,7 +268,7 @@ fn same_origin<L: Lane>(rays: &RayPacket<L>, valid: L::Mask) -> bool {
 }
 
 /// A packet's [`Frustum`], tested against a node's children for the whole packet at once.
-struct Cone {
+pub(crate) struct Cone {
     f: Frustum,
     /// The lanes' lowest `t_min` and highest `t_max`.
     t_lo: f32,
@@ -274,6 +276,14 @@ struct Cone {
     /// Rays from one point (a camera's): the frustum is tight, and the lanes of an inner child
     /// it enters are not tested one by one (they are at its leaves).
     one_eye: bool,
+}
+
+impl Cone {
+    /// Bit `k` set when some lane may enter box `k` of a leaf's (rows as [`Leaf::boxes`](super::Leaf::boxes)).
+    #[inline(always)]
+    pub(crate) fn enters(&self, b: [wide::f32x4; 6]) -> u32 {
+        self.f.test4(b, self.t_lo, self.t_hi)
+    }
 }
 
 /// A packet's [`Cone`], where it has more than one lane.
