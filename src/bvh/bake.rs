@@ -58,6 +58,7 @@
 use glam::Vec3;
 use wide::f32x4;
 
+use super::leaf::triangle_boxes;
 use super::node::{Layout, MAX_DEPTH4, Node4, SIMD, STACK4};
 use super::{EMPTY, LEAF, split, traverse};
 use crate::hit::{At, Collector, Hits, Record, Winners, alone};
@@ -525,10 +526,17 @@ impl Set for Baked<'_> {
             self.reach,
             &rays,
             c,
-            |r_leaf, r, _, c| {
+            |r_leaf, r, cone, c| {
                 let (first, count) = Self::leaf(r_leaf);
+                // The triangles whose boxes the packet's cone may enter (as `leaf_many`).
+                let keep = cone.map_or(u32::MAX, |f| {
+                    f.enters(triangle_boxes(&self.four(first, count)))
+                });
                 let mut r = *r;
-                for t in first..first + count {
+                for (k, t) in (first..first + count).enumerate() {
+                    if keep & (1 << k) == 0 {
+                        continue;
+                    }
                     r.t_max = c.t_max();
                     let tri = self.triangle(t);
                     let at = At {

@@ -177,19 +177,25 @@ impl Leaf for Tri4 {
 
     #[inline(always)]
     fn boxes(&self) -> [f32x4; 6] {
-        // As `bounds` for every triangle that can be hit (no NaN vertex).
-        let (a, b, c) = (lanes4(&self.a), lanes4(&self.b), lanes4(&self.c));
-        let lo = |a: f32x4, b: f32x4, c: f32x4| a.fast_min(b).fast_min(c);
-        let hi = |a: f32x4, b: f32x4, c: f32x4| a.fast_max(b).fast_max(c);
-        [
-            lo(a.x, b.x, c.x),
-            lo(a.y, b.y, c.y),
-            lo(a.z, b.z, c.z),
-            hi(a.x, b.x, c.x),
-            hi(a.y, b.y, c.y),
-            hi(a.z, b.z, c.z),
-        ]
+        triangle_boxes(&self.four())
     }
+}
+
+/// The boxes of four triangles in lanes, as [`Packed::bounds`] gives them for every triangle
+/// that can be hit (no NaN vertex): rows minimum x, y, z, maximum x, y, z.
+#[inline(always)]
+pub(crate) fn triangle_boxes(p: &TrianglePacket<f32x4>) -> [f32x4; 6] {
+    let lo = |a: f32x4, b: f32x4, c: f32x4| a.fast_min(b).fast_min(c);
+    let hi = |a: f32x4, b: f32x4, c: f32x4| a.fast_max(b).fast_max(c);
+    let (a, b, c) = (p.a, p.b, p.c);
+    [
+        lo(a.x, b.x, c.x),
+        lo(a.y, b.y, c.y),
+        lo(a.z, b.z, c.z),
+        hi(a.x, b.x, c.x),
+        hi(a.y, b.y, c.y),
+        hi(a.z, b.z, c.z),
+    ]
 }
 
 impl Packed for Sphere4 {
