@@ -698,8 +698,8 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
 /// in order, each offered to `c`. With the packet's `cone`, only the primitives whose boxes
 /// it may enter (one `f32x4` interval test for the four; a pure prune, see the module docs):
 /// in a camera's 4 × 4 blocks a leaf's box is met far more often than each of its triangles'
-/// (callgrind, x86-64-v3, the vendored bunny: 348 → 285 instructions per primary ray in
-/// packets of 16, 377 → 337 in packets of 8, shadow packets of 8 510 → 471; time on the
+/// (callgrind, x86-64-v3, the vendored bunny: 348 → 284 instructions per primary ray in
+/// packets of 16, 377 → 335 in packets of 8, shadow packets of 8 510 → 467; time on the
 /// benchmark's AVX-512 build within the noise, on a default SSE2 build primary packets of 16
 /// 1.18–1.39× faster).
 #[inline(always)]
