@@ -290,6 +290,44 @@ fn rays_grazing_box_faces() {
     }
     let hits = check_tris(&tris, &rs);
     assert!(hits > 500, "{hits}");
+    // Packets from one eye (16 rays per eye, so every packet of 4, 8 or 16 shares it: the
+    // frustum tests the leaves' flat triangle boxes), eyes on grid points, in the planes and
+    // off them, aimed at grid points and edge midpoints; then packets whose origins differ
+    // but whose directions share their signs (a frustum, not one eye).
+    let mut rs = Vec::new();
+    for e in 0..40 {
+        let half = |rng: &mut SmallRng| rng.random_range(0..14) as f32 * 0.5;
+        let eye = match e % 4 {
+            0 => Vec3::new(half(&mut rng), half(&mut rng), 0.0),
+            1 => Vec3::new(half(&mut rng) - 1.0, half(&mut rng), 1.0),
+            2 => Vec3::new(half(&mut rng), half(&mut rng), 2.5),
+            _ => v3(&mut rng, 4.0) + Vec3::splat(3.0),
+        };
+        for _ in 0..16 {
+            let z = [0.0, 1.0, 0.5][rng.random_range(0..3)];
+            let p = Vec3::new(half(&mut rng), half(&mut rng), z);
+            let d = p - eye;
+            rs.push(Ray::new(eye, if d == Vec3::ZERO { Vec3::Z } else { d }));
+        }
+    }
+    for _ in 0..40 {
+        let d = Vec3::new(
+            rng.random_range(0.1..1.0),
+            rng.random_range(0.1..1.0),
+            -rng.random_range(0.1..1.0),
+        );
+        for _ in 0..16 {
+            let o = Vec3::new(half_step(&mut rng), half_step(&mut rng), 2.0) - d * 3.0;
+            rs.push(Ray::with_interval(o, d, 0.0, 10.0));
+        }
+    }
+    let hits = check_tris(&tris, &rs);
+    assert!(hits > 500, "{hits}");
+}
+
+/// A grid coordinate in steps of ½ from 0 to 6.5.
+fn half_step(rng: &mut SmallRng) -> f32 {
+    rng.random_range(0..14) as f32 * 0.5
 }
 
 /// Bad input builds a valid tree (accepted by `from_parts`), never panics, and the answers
