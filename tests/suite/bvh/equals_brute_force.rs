@@ -176,6 +176,36 @@ fn random_sphere_sets_equal_brute_force() {
     }
 }
 
+/// Packets of 16 rays from one eye in the plane of a face of a sphere's box, aimed within
+/// `2^-16` of the point where the sphere touches that face: tangent rays that graze the box
+/// (hits and misses decided by rounding). The frustum's prune of the leaf's sphere boxes must
+/// let every such sphere through; the answers equal brute force at every width.
+#[test]
+fn sphere_packets_at_their_boxes_faces() {
+    let mut rng = SmallRng::seed_from_u64(23);
+    let mut spheres = Vec::new();
+    for i in 0..27 {
+        let c = Vec3::new((i % 3) as f32, (i / 3 % 3) as f32, (i / 9) as f32);
+        spheres.push(Sphere::new(c, 0.4));
+    }
+    let mut rs = Vec::new();
+    for _ in 0..60 {
+        let s = spheres[rng.random_range(0..spheres.len())];
+        let mut axis = Vec3::ZERO;
+        axis[rng.random_range(0..3)] = if rng.random_bool(0.5) { 1.0 } else { -1.0 };
+        let p = s.center() + axis * s.radius();
+        // A direction in the face's plane (perpendicular to the axis).
+        let u = v3(&mut rng, 1.0).reject_from_normalized(axis);
+        let eye = p + u.normalize_or(Vec3::ONE.reject_from_normalized(axis)) * 3.0;
+        for _ in 0..16 {
+            let jitter = v3(&mut rng, 1.0) * (1.0 / 65536.0);
+            rs.push(Ray::new(eye, p + jitter - eye));
+        }
+    }
+    let hits = check_spheres(&spheres, &rs);
+    assert!(hits > 100, "{hits}");
+}
+
 #[test]
 fn vendored_bunny_equals_brute_force() {
     let m = crate::sets::bunny_visible_surface::load_bin(include_bytes!("../../data/bunny.bin"));
