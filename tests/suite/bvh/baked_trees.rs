@@ -12,7 +12,7 @@ use raylane::triangle::{Moller, Triangle};
 use raylane::{Cull, Query, Ray, RayPacket};
 use wide::f32x8;
 
-use crate::bvh::equals_brute_force::{check, rays, soup};
+use crate::bvh::equals_brute_force::{check, grazing_grid, grazing_packets, rays, soup};
 use crate::sets::query_records_every_width::bits;
 
 /// The bytes at a 16-byte boundary (as `include_baked!` links them).
@@ -109,6 +109,25 @@ fn baked_soups_and_bad_triangles_answer_as_their_meshes() {
         let centroids: Vec<Vec3> = tris.iter().map(|t| (t.a() + t.b() + t.c()) / 3.0).collect();
         check(&tree, &mesh, &rays(&mut rng, 400, &centroids));
     }
+}
+
+/// The grazing grid (flat triangle boxes meeting along grid lines) baked: packets from one eye
+/// and frustum packets (the leaves' triangle boxes pruned by the frustum) answer as the mesh.
+#[test]
+fn baked_grids_answer_packets_as_their_meshes() {
+    let mut pos = Vec::new();
+    let mut idx = Vec::new();
+    for t in grazing_grid() {
+        let k = pos.len() as u32;
+        pos.extend([t.a(), t.b(), t.c()]);
+        idx.push([k, k + 1, k + 2]);
+    }
+    let mesh = Mesh::new(&pos, &idx);
+    let bytes = bake(&mesh).unwrap();
+    let a = aligned(&bytes);
+    let tree = Baked::open(&a.0[..bytes.len()]).unwrap();
+    let rs = grazing_packets(&mut SmallRng::seed_from_u64(24));
+    assert!(check(&tree, &mesh, &rs) > 500);
 }
 
 #[test]

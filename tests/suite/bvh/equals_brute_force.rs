@@ -271,30 +271,7 @@ fn watertight_sets_no_leaks_through_the_tree() {
 /// along box edges and hitting box corners: nothing is lost to the box test.
 #[test]
 fn rays_grazing_box_faces() {
-    let mut tris = Vec::new();
-    // A 6×6 grid of unit squares in the planes z = 0 and z = 1, and walls at x = k.
-    for i in 0..6 {
-        for j in 0..6 {
-            let (x, y) = (i as f32, j as f32);
-            for z in [0.0, 1.0] {
-                tris.push(Triangle::new(
-                    Vec3::new(x, y, z),
-                    Vec3::new(x + 1.0, y, z),
-                    Vec3::new(x + 1.0, y + 1.0, z),
-                ));
-                tris.push(Triangle::new(
-                    Vec3::new(x, y, z),
-                    Vec3::new(x + 1.0, y + 1.0, z),
-                    Vec3::new(x, y + 1.0, z),
-                ));
-            }
-            tris.push(Triangle::new(
-                Vec3::new(x, y, 0.0),
-                Vec3::new(x, y + 1.0, 0.0),
-                Vec3::new(x, y, 1.0),
-            ));
-        }
-    }
+    let tris = grazing_grid();
     let mut rs = Vec::new();
     let mut rng = SmallRng::seed_from_u64(17);
     for _ in 0..600 {
@@ -320,22 +297,56 @@ fn rays_grazing_box_faces() {
     }
     let hits = check_tris(&tris, &rs);
     assert!(hits > 500, "{hits}");
-    // Packets from one eye (16 rays per eye, so every packet of 4, 8 or 16 shares it: the
-    // frustum tests the leaves' flat triangle boxes), eyes on grid points, in the planes and
-    // off them, aimed at grid points and edge midpoints; then packets whose origins differ
-    // but whose directions share their signs (a frustum, not one eye).
+    let rs = grazing_packets(&mut rng);
+    let hits = check_tris(&tris, &rs);
+    assert!(hits > 500, "{hits}");
+}
+
+/// A 6×6 grid of unit squares in the planes z = 0 and z = 1, and walls at x = k: triangles
+/// whose boxes are flat, meeting along grid lines.
+pub(crate) fn grazing_grid() -> Vec<Triangle> {
+    let mut tris = Vec::new();
+    for i in 0..6 {
+        for j in 0..6 {
+            let (x, y) = (i as f32, j as f32);
+            for z in [0.0, 1.0] {
+                tris.push(Triangle::new(
+                    Vec3::new(x, y, z),
+                    Vec3::new(x + 1.0, y, z),
+                    Vec3::new(x + 1.0, y + 1.0, z),
+                ));
+                tris.push(Triangle::new(
+                    Vec3::new(x, y, z),
+                    Vec3::new(x + 1.0, y + 1.0, z),
+                    Vec3::new(x, y + 1.0, z),
+                ));
+            }
+            tris.push(Triangle::new(
+                Vec3::new(x, y, 0.0),
+                Vec3::new(x, y + 1.0, 0.0),
+                Vec3::new(x, y, 1.0),
+            ));
+        }
+    }
+    tris
+}
+
+/// Packets of 16 rays from one eye (so every packet of 4, 8 or 16 shares it: the frustum
+/// tests the leaves' flat triangle boxes), eyes on grid points, in the planes and off them,
+/// aimed at grid points and edge midpoints of [`grazing_grid`]; then packets whose origins
+/// differ but whose directions share their signs (a frustum, not one eye).
+pub(crate) fn grazing_packets(rng: &mut SmallRng) -> Vec<Ray> {
     let mut rs = Vec::new();
     for e in 0..40 {
-        let half = |rng: &mut SmallRng| rng.random_range(0..14) as f32 * 0.5;
         let eye = match e % 4 {
-            0 => Vec3::new(half(&mut rng), half(&mut rng), 0.0),
-            1 => Vec3::new(half(&mut rng) - 1.0, half(&mut rng), 1.0),
-            2 => Vec3::new(half(&mut rng), half(&mut rng), 2.5),
-            _ => v3(&mut rng, 4.0) + Vec3::splat(3.0),
+            0 => Vec3::new(half_step(rng), half_step(rng), 0.0),
+            1 => Vec3::new(half_step(rng) - 1.0, half_step(rng), 1.0),
+            2 => Vec3::new(half_step(rng), half_step(rng), 2.5),
+            _ => v3(rng, 4.0) + Vec3::splat(3.0),
         };
         for _ in 0..16 {
             let z = [0.0, 1.0, 0.5][rng.random_range(0..3)];
-            let p = Vec3::new(half(&mut rng), half(&mut rng), z);
+            let p = Vec3::new(half_step(rng), half_step(rng), z);
             let d = p - eye;
             rs.push(Ray::new(eye, if d == Vec3::ZERO { Vec3::Z } else { d }));
         }
@@ -347,12 +358,11 @@ fn rays_grazing_box_faces() {
             -rng.random_range(0.1..1.0),
         );
         for _ in 0..16 {
-            let o = Vec3::new(half_step(&mut rng), half_step(&mut rng), 2.0) - d * 3.0;
+            let o = Vec3::new(half_step(rng), half_step(rng), 2.0) - d * 3.0;
             rs.push(Ray::with_interval(o, d, 0.0, 10.0));
         }
     }
-    let hits = check_tris(&tris, &rs);
-    assert!(hits > 500, "{hits}");
+    rs
 }
 
 /// A grid coordinate in steps of ½ from 0 to 6.5.
