@@ -319,3 +319,52 @@ impl Primitives for [Sphere] {
         leaf.index[k] = i;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Lane `k` of [`Leaf::boxes`] is [`Packed::bounds`]`(k)`, bit for bit, for triangles and
+    /// spheres that can be hit (tiny, huge, negative and axis-flat ones), so the packets'
+    /// prune tests the boxes the builder used.
+    #[test]
+    fn lane_boxes_are_the_bounds() {
+        let coords = [
+            0.0, -0.0, 1.5, -3.25, 1e-30, -7e-20, 3e15, -2.5e20, 0.1, 0.7,
+        ];
+        let v = |i: usize| {
+            let c = |j: usize| coords[(i * 7 + j * 3) % coords.len()];
+            Vec3::new(c(0), c(1), c(2))
+        };
+        let mut checked = 0;
+        for round in 0..12 {
+            let mut tris = Tri4::EMPTY;
+            let mut spheres = Sphere4::EMPTY;
+            for k in 0..LEAF_WIDTH {
+                let i = round * LEAF_WIDTH + k;
+                let t = Triangle::new(v(i), v(i + 1), v(i + 5));
+                tris.set_triangle(k, &t, i as u32);
+                set(&mut spheres.center, k, v(i));
+                spheres.radius[k] = [0.0, 0.25, 1e-20, 4e10][i % 4];
+                spheres.index[k] = i as u32;
+            }
+            let bounds = |k: usize| (Packed::bounds(&tris, k), Packed::bounds(&spheres, k));
+            for (which, boxes) in [tris.boxes(), spheres.boxes()].into_iter().enumerate() {
+                for k in 0..LEAF_WIDTH {
+                    let (t, s) = bounds(k);
+                    let (lo, hi) = if which == 0 { t } else { s };
+                    if !lo.iter().zip(&hi).all(|(a, b)| a <= b) {
+                        continue; // never hit (a zero-area triangle): nothing to prune
+                    }
+                    checked += 1;
+                    let lane = |r: usize| boxes[r].to_array()[k].to_bits();
+                    for a in 0..3 {
+                        assert_eq!(lane(a), lo[a].to_bits(), "round {round}, lane {k}");
+                        assert_eq!(lane(3 + a), hi[a].to_bits(), "round {round}, lane {k}");
+                    }
+                }
+            }
+        }
+        assert!(checked > 80, "{checked}");
+    }
+}

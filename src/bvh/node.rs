@@ -714,7 +714,7 @@ impl Frustum {
     /// [`Frustum::test`] on the boxes of a leaf's four primitives (minimum x, y, z, maximum
     /// x, y, z, a primitive per lane): bit `k` set when some lane may enter box `k`.
     #[inline(always)]
-    pub fn test4(&self, b: [f32x4; 6], t_lo: f32, t_hi: f32) -> u32 {
+    pub(crate) fn test4(&self, b: [f32x4; 6], t_lo: f32, t_hi: f32) -> u32 {
         self.test_rows(|r| b[r], t_lo, t_hi).0
     }
 

@@ -7,10 +7,10 @@
 //! A leaf closure offers its candidates to the collector and returns true when the collector
 //! asked to stop; the loops read the collector's `t_max` to prune. A packet's leaf closure
 //! also gets the packet's [`Cone`] (where it has one), to skip the primitives whose boxes no
-//! lane may enter. A one-ray traversal whose
-//! short stack overflows runs again with the full one (keeping what the collector found: a
-//! closest hit found is still a candidate, and `any` had found nothing), except for
-//! collectors that report every hit, which start with the full stack.
+//! lane may enter. A one-ray traversal whose short stack overflows runs again with the full
+//! one (keeping what the collector found: a closest hit found is still a candidate, and `any`
+//! had found nothing), except for collectors that report every hit, which start with the full
+//! stack.
 //!
 //! A packet's stack entries carry the lanes that entered each box, so a subtree only a few
 //! lanes reach continues as single rays ([`many`]'s `single`: the caller's one-ray traversal
@@ -279,7 +279,8 @@ pub(crate) struct Cone {
 }
 
 impl Cone {
-    /// Bit `k` set when some lane may enter box `k` of a leaf's (rows as [`Leaf::boxes`](super::Leaf::boxes)).
+    /// Bit `k` set when some lane may enter the box of a leaf's primitive `k` (rows as
+    /// [`Leaf::boxes`](super::Leaf::boxes)).
     #[inline(always)]
     pub(crate) fn enters(&self, b: [wide::f32x4; 6]) -> u32 {
         self.f.test4(b, self.t_lo, self.t_hi)
