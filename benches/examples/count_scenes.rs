@@ -68,7 +68,7 @@ fn measure() {
     let mut ebr = EmbreeBvh::mesh(&m, true);
     let (p, d, s) = (&w.primary[..], &w.diffuse[..], &w.shadow[..]);
     let (p8, p16) = (rl::packets::<f32x8>(p), rl::packets::<f32x16>(p));
-    let s8 = rl::packets::<f32x8>(s);
+    let (d8, s8) = (rl::packets::<f32x8>(d), rl::packets::<f32x8>(s));
     let (ep, ed, es) = (EmbreeRays::new(p), EmbreeRays::new(d), EmbreeRays::new(s));
     let run = |name: &str, rays: usize, f: &dyn Fn() -> u32| {
         println!("{} {rays}", name.replace(' ', "_"));
@@ -109,6 +109,9 @@ fn measure() {
     ebr.set_coherent(false);
     run("diffuse raylane BVH x1", d.len(), &|| {
         rl::bvh_closest1(&tree, d, None)
+    });
+    run("diffuse raylane BVH x8", d.len(), &|| {
+        rl::bvh_closest(&tree, &d8, d.len(), None)
     });
     run("diffuse raylane BVH Möller x1", d.len(), &|| {
         rl::bvh_closest1(&m, d, None)
