@@ -413,6 +413,21 @@ const INV_MAX: f32 = 1.2676506e30;
 const D_LO: f32 = 5.421011e-20;
 const D_HI: f32 = 1.8446744e19;
 
+/// The one-ray slab test in the fused form, `fma(b, 1/d, −(o ± m)/d)`: where `f32x8::mul_add`
+/// is one fused instruction (x86-64 with AVX and FMA, AArch64). A node test only prunes (see
+/// the [module docs](super)), so a target may take either form; the answers are the same.
+const FUSED: bool = cfg!(any(
+    all(
+        any(target_arch = "x86_64", target_arch = "x86"),
+        target_feature = "avx",
+        target_feature = "fma"
+    ),
+    all(target_arch = "aarch64", target_feature = "neon")
+));
+/// With the fused form, rays whose `(R + |o|∞) / |d|∞` exceeds `2^106` visit every child (see
+/// [`Slab::new`]; never with `|d|∞ ≥ 2^-6`).
+const SPAN_PER_D: f32 = f32::from_bits((127 + 106) << 23);
+
 /// The per-ray constants of the slab test, for one ray: which plane is near on each axis
 /// (a row of [`Node::bounds`]), the two widened origins and the clamped inverse direction.
 #[derive(Clone, Copy, Debug)]
@@ -422,6 +437,9 @@ pub struct Slab {
     on: [f32; 3],
     of: [f32; 3],
     inv: [f32; 3],
+    /// `on·inv`, `of·inv` (rounded once), for the fused form ([`FUSED`]).
+    qn: [f32; 3],
+    qf: [f32; 3],
     /// Visit every non-empty child (the slab test's range is exceeded).
     all: bool,
 }
@@ -433,21 +451,35 @@ impl Slab {
         let omax = o[0].abs().max(o[1].abs()).max(o[2].abs());
         let dmax = d[0].abs().max(d[1].abs()).max(d[2].abs());
         let span = reach + omax;
-        let all = !(span <= FAR && (D_LO..=D_HI).contains(&dmax));
+        let all = !(span <= FAR
+            && (D_LO..=D_HI).contains(&dmax)
+            && (!FUSED || span <= SPAN_PER_D * dmax));
         let m = span * MARGIN;
+        // The fused form needs `(o ± m)·inv` finite: inverses clamped to `2^(125 − e)` for
+        // `span` (never negative) in `[2^e, 2^(e+1))`, so `|o ± m|·lim < 2^126·(1 + 2^-17)`,
+        // where that is below `INV_MAX` (`2^100`: exponent field 227). `span ≤ 2^106·|d|∞`
+        // keeps the clamp at or above `2^19/|d|∞`: conservative (see the module docs).
+        let lim = if FUSED {
+            let e = span.to_bits() >> 23;
+            f32::from_bits(379u32.saturating_sub(e).min(227) << 23)
+        } else {
+            INV_MAX
+        };
         let mut s = Slab {
             near: [0, 1, 2],
             far: [3, 4, 5],
             on: [0.0; 3],
             of: [0.0; 3],
             inv: [0.0; 3],
+            qn: [0.0; 3],
+            qf: [0.0; 3],
             all,
         };
         for a in 0..3 {
             // `+ 0` makes −0 positive, so the plane choice and the inverse's sign agree.
             let da = d[a] + 0.0;
             let neg = da < 0.0;
-            s.inv[a] = (1.0 / da).clamp(-INV_MAX, INV_MAX);
+            s.inv[a] = (1.0 / da).clamp(-lim, lim);
             // Arithmetic rather than branches or selects (which the compiler may turn into
             // branches): the sign of an incoherent ray's direction is unpredictable. `ms` is
             // `±m` (a sign flip, exact), so `o + ms` and `o − ms` are `o ± m` bit for bit.
@@ -457,6 +489,10 @@ impl Slab {
             s.far[a] = 3 + a - 3 * k;
             s.on[a] = o[a] + ms;
             s.of[a] = o[a] - ms;
+            if FUSED {
+                s.qn[a] = s.on[a] * s.inv[a];
+                s.qf[a] = s.of[a] * s.inv[a];
+            }
         }
         s
     }
@@ -481,15 +517,26 @@ impl Slab {
             }
             return (bits, [t_min; WIDTH]);
         }
-        let plane = |p: usize, o: f32, inv: f32| (f32x8::new(b[p]) - f32x8::splat(o)) * inv;
+        // `(b − o)·inv`, or fused `b·inv − o·inv` with `o·inv` made once per ray: 6 fewer
+        // instructions per node.
+        let plane = |p: usize, o: f32, q: f32, inv: f32| {
+            let b = f32x8::new(b[p]);
+            if FUSED {
+                b.mul_add(f32x8::splat(inv), f32x8::splat(-q))
+            } else {
+                (b - f32x8::splat(o)) * inv
+            }
+        };
+        let (n, f) = (self.near, self.far);
+        let (on, of, qn, qf, inv) = (self.on, self.of, self.qn, self.qf, self.inv);
         let tn = f32x8::splat(t_min)
-            .fast_max(plane(self.near[0], self.on[0], self.inv[0]))
-            .fast_max(plane(self.near[1], self.on[1], self.inv[1]))
-            .fast_max(plane(self.near[2], self.on[2], self.inv[2]));
+            .fast_max(plane(n[0], on[0], qn[0], inv[0]))
+            .fast_max(plane(n[1], on[1], qn[1], inv[1]))
+            .fast_max(plane(n[2], on[2], qn[2], inv[2]));
         let tf = f32x8::splat(t_max)
-            .fast_min(plane(self.far[0], self.of[0], self.inv[0]))
-            .fast_min(plane(self.far[1], self.of[1], self.inv[1]))
-            .fast_min(plane(self.far[2], self.of[2], self.inv[2]));
+            .fast_min(plane(f[0], of[0], qf[0], inv[0]))
+            .fast_min(plane(f[1], of[1], qf[1], inv[1]))
+            .fast_min(plane(f[2], of[2], qf[2], inv[2]));
         (tn.simd_le(tf).to_bitmask(), tn.to_array())
     }
 

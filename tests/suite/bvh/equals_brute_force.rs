@@ -448,6 +448,40 @@ fn bad_input_builds_valid_trees() {
     check_tris(&tris, &rs);
 }
 
+/// Scenes far from the origin (`R + |o|∞` up to about `1e12`) with rays along an axis, with
+/// tiny direction components (whose inverses the slab test clamps; where the node test is
+/// fused, per ray: see `Slab::new`) and tiny directions: the tree answers as brute force, with
+/// Möller (hits inside its range at both scales) and Watertight (hits inside its range, `2^30`).
+#[test]
+fn far_scenes_with_flat_directions() {
+    let mut rng = SmallRng::seed_from_u64(23);
+    for &s in &[1e8f32, 1e11] {
+        let at = Vec3::new(1.0, -0.5, 0.25) * (3.0 * s);
+        let tris: Vec<Triangle> = soup(&mut rng, 60)
+            .iter()
+            .map(|t| Triangle::new(t.a() * s + at, t.b() * s + at, t.c() * s + at))
+            .collect();
+        let mut rs = Vec::new();
+        for p in centroids(&tris).iter().take(25) {
+            for &tiny in &[0.0f32, 1e-30, 1e-20, 1e-12, 1e-6] {
+                for &k in &[1.0f32, 1e-15] {
+                    let down = Vec3::new(tiny, -tiny, -1.0) * k;
+                    rs.push(Ray::new(*p + Vec3::new(0.0, 0.0, 4.0 * s), down));
+                    let side = Vec3::new(1.0, tiny, 0.0) * k;
+                    rs.push(Ray::new(*p - Vec3::new(2.0 * s, 0.0, 0.0), side));
+                }
+            }
+        }
+        let (nodes, leaves) = owned(&tris[..]);
+        let tree = Bvh::from_parts(&nodes, &leaves).expect("a valid tree");
+        let flat: &[Triangle] = &tris;
+        let hits = check(&tree.using::<Moller>(), &flat.using::<Moller>(), &rs);
+        assert!(hits > rs.len() / 4, "scale {s}: {hits} Möller hits");
+        let hits = check(&tree, &flat, &rs);
+        assert!(s > 1e9 || hits > rs.len() / 4, "scale {s}: {hits} hits");
+    }
+}
+
 #[test]
 fn short_storage_is_an_error() {
     let mut rng = SmallRng::seed_from_u64(19);
