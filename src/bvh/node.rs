@@ -405,13 +405,6 @@ pub(crate) const SIMD: bool = cfg!(any(target_feature = "sse2", target_feature =
 /// The box widening relative to `R + |o|∞`: `2^-17` (see the [module docs](super) for why it
 /// is conservative).
 pub(crate) const MARGIN: f32 = 1.0 / 131072.0;
-/// The largest `R + |o|∞` the slab test handles (`2^100`); beyond it every child is visited.
-const FAR: f32 = 1.2676506e30;
-/// Inverse direction components are clamped to `±2^100` (a zero component gives `±2^100`).
-const INV_MAX: f32 = 1.2676506e30;
-/// `|d|∞` must lie in `2^-64…2^64` for the slab test; outside, every child is visited.
-const D_LO: f32 = 5.421011e-20;
-const D_HI: f32 = 1.8446744e19;
 
 /// The one-ray slab test in the fused form, `fma(b, 1/d, −(o ± m)/d)`: where `f32x8::mul_add`
 /// is one fused instruction (x86-64 with AVX and FMA, AArch64). A node test only prunes (see
@@ -424,9 +417,20 @@ const FUSED: bool = cfg!(any(
     ),
     all(target_arch = "aarch64", target_feature = "neon")
 ));
-/// With the fused form, rays whose `(R + |o|∞) / |d|∞` exceeds `2^106` visit every child (see
-/// [`Slab::new`]; never with `|d|∞ ≥ 2^-6`).
-const SPAN_PER_D: f32 = f32::from_bits((127 + 106) << 23);
+/// `2^e` for `−126 ≤ e ≤ 127`, in constants.
+const fn two_to(e: i32) -> f32 {
+    f32::from_bits(((127 + e) as u32) << 23)
+}
+/// The largest `R + |o|∞` the slab test handles (`2^100`; `2^63` fused); beyond it every child
+/// is visited.
+const FAR: f32 = two_to(if FUSED { 63 } else { 100 });
+/// Inverse direction components are clamped to `±2^100` (`±2^64` fused; a zero component
+/// gives the clamp). Fused, `(o ± m)·inv` stays below `2^63·(1 + 2^-17)·2^64`: finite.
+const INV_MAX: f32 = two_to(if FUSED { 64 } else { 100 });
+/// `|d|∞` must lie in `2^-64…2^64` (`2^-45…2^64` fused: the clamp stays at or above
+/// `2^19/|d|∞`) for the slab test; outside, every child is visited.
+const D_LO: f32 = two_to(if FUSED { -45 } else { -64 });
+const D_HI: f32 = two_to(64);
 
 /// The per-ray constants of the slab test, for one ray: which plane is near on each axis
 /// (a row of [`Node::bounds`]), the two widened origins and the clamped inverse direction.
@@ -451,20 +455,8 @@ impl Slab {
         let omax = o[0].abs().max(o[1].abs()).max(o[2].abs());
         let dmax = d[0].abs().max(d[1].abs()).max(d[2].abs());
         let span = reach + omax;
-        let all = !(span <= FAR
-            && (D_LO..=D_HI).contains(&dmax)
-            && (!FUSED || span <= SPAN_PER_D * dmax));
+        let all = !(span <= FAR && (D_LO..=D_HI).contains(&dmax));
         let m = span * MARGIN;
-        // The fused form needs `(o ± m)·inv` finite: inverses clamped to `2^(125 − e)` for
-        // `span` (never negative) in `[2^e, 2^(e+1))`, so `|o ± m|·lim < 2^126·(1 + 2^-17)`,
-        // where that is below `INV_MAX` (`2^100`: exponent field 227). `span ≤ 2^106·|d|∞`
-        // keeps the clamp at or above `2^19/|d|∞`: conservative (see the module docs).
-        let lim = if FUSED {
-            let e = span.to_bits() >> 23;
-            f32::from_bits(379u32.saturating_sub(e).min(227) << 23)
-        } else {
-            INV_MAX
-        };
         let mut s = Slab {
             near: [0, 1, 2],
             far: [3, 4, 5],
@@ -479,7 +471,7 @@ impl Slab {
             // `+ 0` makes −0 positive, so the plane choice and the inverse's sign agree.
             let da = d[a] + 0.0;
             let neg = da < 0.0;
-            s.inv[a] = (1.0 / da).clamp(-lim, lim);
+            s.inv[a] = (1.0 / da).clamp(-INV_MAX, INV_MAX);
             // Arithmetic rather than branches or selects (which the compiler may turn into
             // branches): the sign of an incoherent ray's direction is unpredictable. `ms` is
             // `±m` (a sign flip, exact), so `o + ms` and `o − ms` are `o ± m` bit for bit.

@@ -464,7 +464,7 @@ fn far_scenes_with_flat_directions() {
         let mut rs = Vec::new();
         for p in centroids(&tris).iter().take(25) {
             for &tiny in &[0.0f32, 1e-30, 1e-20, 1e-12, 1e-6] {
-                for &k in &[1.0f32, 1e-15] {
+                for &k in &[1.0f32, 1e-13, 1e-15] {
                     let down = Vec3::new(tiny, -tiny, -1.0) * k;
                     rs.push(Ray::new(*p + Vec3::new(0.0, 0.0, 4.0 * s), down));
                     let side = Vec3::new(1.0, tiny, 0.0) * k;
