@@ -114,13 +114,14 @@
 //!    with `(o ± m)·(1/d)` rounded once per ray: as many roundings, 6 fewer instructions per
 //!    node (callgrind, x86-64-v3, the vendored bunny: 2–4 % fewer per ray). It needs
 //!    `(o ± m)·(1/d)` finite, so on those targets (for packets too) the limits are `2^63` for
-//!    `R + |o|∞`, `±2^64` for the inverses and `2^-45` for `|d|∞`: the product stays below `2^127·(1 + 2^-17)`, and the
-//!    clamp stays at or above `2^19/|d|∞`, so a ray whose inverse it cuts moves less than
-//!    `m/4` along that axis over any `t` a hit can have (`|t| ≤ (R + |o|∞)/|d|∞`), and its
-//!    slab on that axis spans those `t` (the test `far_scenes_with_flat_directions` fails
-//!    with the clamp at `2^40`). The argument is per primitive's box, so a packet with a
-//!    frustum also tests the boxes of a leaf's primitives (`Leaf::boxes`, as the builder
-//!    bounds them) before their kernels run: a pure prune as well.
+//!    `R + |o|∞`, `±2^64` for the inverses and `2^-45` for `|d|∞`: the product stays below
+//!    `2^127·(1 + 2^-17)`, and the clamp stays at or above `2^19/|d|∞`, so a ray whose
+//!    inverse it cuts moves less than `m/4` along that axis over any `t` a hit can have
+//!    (`|t| ≤ (R + |o|∞)/|d|∞`), and its slab on that axis spans those `t` (the test
+//!    `far_scenes_with_flat_directions` fails with the clamp at `2^40`). The argument is per
+//!    primitive's box, so a packet with a frustum also tests the boxes of a leaf's primitives
+//!    (`Leaf::boxes`, as the builder bounds them) before their kernels run: a pure prune as
+//!    well.
 //!
 //! The interval is decided by the collector alone — a hit counts when its rounded `t` lies in
 //! `(t_min, t_max)` — so the tree and brute force agree for every `t_max`, finite or not, and

@@ -449,9 +449,10 @@ fn bad_input_builds_valid_trees() {
 }
 
 /// Scenes far from the origin (`R + |o|∞` up to about `1e12`) with rays along an axis, with
-/// tiny direction components (whose inverses the slab test clamps; where the node test is
-/// fused, per ray: see `Slab::new`) and tiny directions: the tree answers as brute force, with
-/// Möller (hits inside its range at both scales) and Watertight (hits inside its range, `2^30`).
+/// tiny direction components (whose inverses the slab test clamps: at `±2^64` where the node
+/// test is fused) and whole directions just above and below the fused test's `|d|∞` limit
+/// (`2^-45`): the tree answers as brute force, with Möller (hits inside its range at both
+/// scales) and Watertight (hits inside its range, `2^30`).
 #[test]
 fn far_scenes_with_flat_directions() {
     let mut rng = SmallRng::seed_from_u64(23);
