@@ -32,7 +32,7 @@
 use glam::Vec3;
 
 use crate::kernel::{Cull, LaneHit, Primitive, plus_zero};
-use crate::lane::{Lane, Mask, Scalar, select_indices};
+use crate::lane::{Lane, Mask, Scalar, pow2, select_indices};
 use crate::plane::Plane;
 use crate::ray::RayPacket;
 use crate::sphere::Sphere;
@@ -83,11 +83,6 @@ pub struct Hits<L: Lane> {
     pub v: L,
     /// Lanes that hit.
     pub mask: L::Mask,
-}
-
-/// `2^e` for `-126 ≤ e ≤ 127`.
-const fn pow2(e: i32) -> f32 {
-    f32::from_bits(((127 + e) as u32) << 23)
 }
 
 impl<L: Lane> Hits<L> {

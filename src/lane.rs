@@ -156,6 +156,11 @@ impl Mask for bool {
 /// ```
 pub const MAX_LANES: usize = 16;
 
+/// An exact power of two, `2^e` (for `-126 ≤ e ≤ 127`), in constants and kernels alike.
+pub(crate) const fn pow2(e: i32) -> f32 {
+    f32::from_bits(((127 + e) as u32) << 23)
+}
+
 /// Compile-time check that `L` has at most [`MAX_LANES`] lanes: called by every function that
 /// gathers lanes into a `[_; MAX_LANES]` array, it fails the build (error E0080) when that
 /// function is instantiated with a wider lane type.

@@ -417,20 +417,16 @@ const FUSED: bool = cfg!(any(
     ),
     all(target_arch = "aarch64", target_feature = "neon")
 ));
-/// `2^e` for `−126 ≤ e ≤ 127`, in constants.
-const fn two_to(e: i32) -> f32 {
-    f32::from_bits(((127 + e) as u32) << 23)
-}
 /// The largest `R + |o|∞` the slab test handles (`2^100`; `2^63` fused); beyond it every child
 /// is visited.
-const FAR: f32 = two_to(if FUSED { 63 } else { 100 });
+const FAR: f32 = crate::lane::pow2(if FUSED { 63 } else { 100 });
 /// Inverse direction components are clamped to `±2^100` (`±2^64` fused; a zero component
 /// gives the clamp). Fused, `(o ± m)·inv` stays below `2^63·(1 + 2^-17)·2^64`: finite.
-const INV_MAX: f32 = two_to(if FUSED { 64 } else { 100 });
+const INV_MAX: f32 = crate::lane::pow2(if FUSED { 64 } else { 100 });
 /// `|d|∞` must lie in `2^-64…2^64` (`2^-45…2^64` fused: the clamp stays at or above
 /// `2^19/|d|∞`) for the slab test; outside, every child is visited.
-const D_LO: f32 = two_to(if FUSED { -45 } else { -64 });
-const D_HI: f32 = two_to(64);
+const D_LO: f32 = crate::lane::pow2(if FUSED { -45 } else { -64 });
+const D_HI: f32 = crate::lane::pow2(64);
 
 /// The per-ray constants of the slab test, for one ray: which plane is near on each axis
 /// (a row of [`Node::bounds`]), the two widened origins and the clamped inverse direction.

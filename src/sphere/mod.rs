@@ -65,7 +65,7 @@ pub use focal::FocalSphere;
 use glam::Vec3;
 
 use crate::kernel::{Cull, Kernel, LaneHit, Primitive};
-use crate::lane::{Lane, Mask, Scalar};
+use crate::lane::{Lane, Mask, Scalar, pow2};
 use crate::ray::RayPacket;
 use crate::vec3::V3;
 
@@ -304,11 +304,6 @@ pub trait SphereKernel {
     /// All roots of each ray lane against the sphere in the same lane, ascending, inside the
     /// ray's interval.
     fn roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Roots<L>;
-}
-
-/// An exact power of two, `2^e` (for `-126 ≤ e ≤ 127`).
-pub(crate) const fn pow2(e: i32) -> f32 {
-    f32::from_bits(((127 + e) as u32) << 23)
 }
 
 /// Lower end of the squared magnitudes the f32 kernels accept on their fast path (`2^-60`).
