@@ -29,8 +29,8 @@ bin="$root/target/count-x86-64-v3/release/examples/count"
 dir=$(mktemp -d "$out/callgrind.XXXXXX")
 trap 'rm -rf "$dir"' EXIT
 valgrind --tool=callgrind --collect-atstart=no \
-  --toggle-collect='*packets_frame*' --toggle-collect='*soa_frame*' \
-  --dump-after='raylane_bench::packets_frame' --dump-after='raylane_bench::soa_frame' \
+  --toggle-collect='*packets_frame*' --toggle-collect='*rays_frame*' \
+  --dump-after='raylane_bench::packets_frame' --dump-after='raylane_bench::rays_frame' \
   --callgrind-out-file="$dir/cg.out" "$bin" measure > "$dir/manifest.txt" 2> "$dir/valgrind.log" \
   || { cat "$dir/valgrind.log" >&2; exit 1; }
 

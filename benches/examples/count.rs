@@ -4,7 +4,7 @@
 //! and the loop's entry and exit cancel out).
 //!
 //! ```text
-//! count measure          run every configuration, one frame call each, printing one
+//! count measure [KERNEL] run every configuration (of one kernel), one frame call each, printing one
 //!                        `cfg KERNEL WIDTH SHAPE RAYS USED TESTS` line before each call
 //!                        (under callgrind: one dump per call, see scripts/count-x86.sh)
 //! count table FILE TITLE print the Markdown table from `cfg ... INSTRUCTIONS` lines
@@ -38,12 +38,19 @@ fn frames() -> Vec<Frame> {
         .collect()
 }
 
-fn shape_name(s: Shape) -> &'static str {
+/// The table's name of a kernel's shape: `query` (N rays × 1 primitive through the library's
+/// `Query`), `loop` (the same shape through the lab's loop, for the kernel without a public
+/// set) or `soa` (1 ray × N primitives, the lab's loop: the kernel alone).
+fn shape_name(k: Kernel, s: Shape) -> &'static str {
     match s {
-        Shape::Packets => "packets",
+        Shape::Packets if k.has_query() => "query",
+        Shape::Packets => "loop",
         Shape::Soa => "soa",
     }
 }
+
+/// The shapes in table order.
+const SHAPES: [&str; 3] = ["query", "loop", "soa"];
 
 fn measure_one<L: Lane<Scalar = f32>>(k: Kernel, shape: Shape, f: &Frame) {
     for used in [N, 0] {
@@ -53,16 +60,21 @@ fn measure_one<L: Lane<Scalar = f32>>(k: Kernel, shape: Shape, f: &Frame) {
             "cfg {} {} {} {} {used} {tests}",
             k.name(),
             L::LANES,
-            shape_name(shape),
+            shape_name(k, shape),
             f.kind.name()
         );
         std::hint::black_box(raylane_bench::run(k, shape, f, &lanes));
     }
 }
 
-fn measure() {
+/// `count measure [KERNEL]`: every kernel, or the one named (for a closer look under a
+/// profiler).
+fn measure(only: Option<&str>) {
     for f in frames() {
         for k in Kernel::ALL {
+            if only.is_some_and(|name| name != k.name()) {
+                continue;
+            }
             for w in raylane_bench::WIDTHS {
                 for shape in [Shape::Packets, Shape::Soa] {
                     if shape == Shape::Soa && !k.has_soa() {
@@ -144,7 +156,7 @@ fn table(file: &str, title: &str) {
     println!("{head}\n{rule}");
     for k in Kernel::ALL {
         for rays in RAYS {
-            for shape in ["packets", "soa"] {
+            for shape in SHAPES {
                 let Some(&(per, _)) = ops.get(&(k.name().to_string(), rays.name().to_string()))
                 else {
                     continue;
@@ -213,7 +225,7 @@ fn print_ops() {
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
-        Some("measure") => measure(),
+        Some("measure") => measure(args.get(1).map(String::as_str)),
         Some("table") => table(
             args.get(1).expect("count table FILE TITLE"),
             args.get(2).map_or("Instructions per test", String::as_str),

@@ -16,11 +16,14 @@ use std::hint::black_box;
 
 use glam::Vec3;
 use raylane::Cull;
+use raylane::focal::{FocalMesh, FocalPlanes, FocalSpheres};
+use raylane::mesh::Mesh;
 use raylane::plane::{FocalPlane, Plane, PlanePacket};
+use raylane::set::Trace;
 use raylane::sphere::focal::{self as sf, FocalKernel};
 use raylane::sphere::{FocalSphere, Sphere, SphereKernel, SpherePacket};
 use raylane::triangle::{FocalTriangle, Triangle, TriangleKernel, TrianglePacket};
-use raylane::{Lane, Mask, Pinhole, Ray, RayPacket};
+use raylane::{Hit, Hits, Lane, Mask, Pinhole, Query, Ray, RayPacket};
 use raylane_lab::loops as internals;
 use raylane_lab::loops::HitRecord;
 use raylane_lab::loops::{Best, LaneRecords};
@@ -325,6 +328,9 @@ pub trait BenchKernel {
     fn runs_on(self, rays: Rays) -> bool;
     /// True when the kernel has the 1 ray × N primitives shape (the focal plane has none).
     fn has_soa(self) -> bool;
+    /// True when the library has a public set for the kernel, which the packet shape then
+    /// queries; false for the unguarded focal sphere (the lab's loop).
+    fn has_query(self) -> bool;
     /// Primitive fields the miss path must read per test (the loads of the op-count
     /// minimum): a sphere's centre and radius (4), a focal sphere's `T` and `k_lo` (4), a
     /// plane's point and normal (6), a focal plane's numerator and normal (4), a triangle's
@@ -342,6 +348,10 @@ impl BenchKernel for Kernel {
         self != Kernel::PlaneFocal
     }
 
+    fn has_query(self) -> bool {
+        self != Kernel::FocalUnguarded
+    }
+
     fn miss_loads(self) -> u32 {
         match self.prim() {
             Prim::Sphere => 4,
@@ -356,9 +366,14 @@ impl BenchKernel for Kernel {
 /// The two packet shapes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Shape {
-    /// N rays × 1 primitive: packets of `L::LANES` rays, each primitive splatted.
+    /// N rays × 1 primitive: what a user calls, the library's [`Query`] (`closest`) on the
+    /// kernel's set — a slice with `using::<K>()`, or a focal cache — for one [`Ray`] (x1) or a
+    /// packet of `L::LANES` rays. Kernels without a public set (the study's precomputed
+    /// triangle methods, the unguarded focal sphere) run the lab's loop instead
+    /// ([`Kernel::has_query`]).
     Packets,
-    /// 1 ray × N primitives: one ray splatted, primitives packed `L::LANES` to a lane value.
+    /// 1 ray × N primitives: one ray splatted, primitives packed `L::LANES` to a lane value
+    /// (the lab's loop: the kernel alone, for the op-count study).
     Soa,
 }
 
@@ -372,44 +387,131 @@ impl Shape {
     }
 }
 
+/// What a frame's query returns, reduced to what the benchmarks read.
+pub trait Answer {
+    /// The lanes (or the ray) that hit.
+    fn hits(&self) -> u32;
+    /// Lane `i` as a record.
+    fn record(&self, i: usize) -> Option<HitRecord>;
+}
+
+impl<L: Lane<Scalar = f32>> Answer for Hits<L> {
+    #[inline(always)]
+    fn hits(&self) -> u32 {
+        self.mask.bits().count_ones()
+    }
+    fn record(&self, i: usize) -> Option<HitRecord> {
+        self.lane(i).map(|h| HitRecord {
+            t: h.t,
+            u: h.u,
+            v: h.v,
+            index: h.index,
+        })
+    }
+}
+
+impl<L: Lane<Scalar = f32>> Answer for Best<L> {
+    #[inline(always)]
+    fn hits(&self) -> u32 {
+        self.mask.bits().count_ones()
+    }
+    fn record(&self, i: usize) -> Option<HitRecord> {
+        LaneRecords::lane(self, i)
+    }
+}
+
+impl Answer for Option<Hit> {
+    #[inline(always)]
+    fn hits(&self) -> u32 {
+        self.is_some() as u32
+    }
+    fn record(&self, _: usize) -> Option<HitRecord> {
+        self.map(|h| HitRecord {
+            t: h.t,
+            u: h.u,
+            v: h.v,
+            index: h.index,
+        })
+    }
+}
+
+impl Answer for Option<HitRecord> {
+    #[inline(always)]
+    fn hits(&self) -> u32 {
+        self.is_some() as u32
+    }
+    fn record(&self, _: usize) -> Option<HitRecord> {
+        *self
+    }
+}
+
 /// One frame of closest-hit queries of ray packets; returns the number of lanes hit. Out of
 /// line, one copy per kernel and width (the closure is inlined into it).
 #[inline(never)]
-pub fn packets_frame<L: Lane, F: Fn(&RayPacket<L>) -> Best<L>>(
+pub fn packets_frame<L: Lane, A: Answer, F: Fn(&RayPacket<L>) -> A>(
     packets: &[RayPacket<L>],
     f: F,
 ) -> u32 {
     let mut n = 0;
     for p in packets {
         let h = f(black_box(p));
-        n += h.mask.bits().count_ones();
+        n += h.hits();
         black_box(&h);
     }
     n
 }
 
-/// One frame of closest-hit queries of single rays over primitives in lanes; returns the
-/// number of rays hit. Out of line, one copy per kernel and width.
+/// One frame of closest-hit queries of single rays (one [`Ray`] through the library's query,
+/// or one ray over primitives in lanes); returns the number of rays hit. Out of line, one
+/// copy per kernel and width.
 #[inline(never)]
-pub fn soa_frame<F: Fn(&Ray) -> Option<HitRecord>>(rays: &[Ray], f: F) -> u32 {
+pub fn rays_frame<A: Answer, F: Fn(&Ray) -> A>(rays: &[Ray], f: F) -> u32 {
     let mut n = 0;
     for r in rays {
         let h = f(black_box(r));
-        n += h.is_some() as u32;
+        n += h.hits();
         black_box(&h);
     }
     n
 }
 
-/// Code run with one kernel's two queries: `packets`, the closest hit of a ray packet over the
-/// frame's primitives (the first `used`), and `soa`, the closest hit of one ray over the
-/// primitives packed in lanes.
+/// A frame's primitives as the library's sets: the focal caches for the camera's eye (built
+/// here, not in a frame: set-up is not timed) and the triangle soup as a mesh.
+pub struct Sets {
+    cache_spheres: Vec<FocalSphere<f32>>,
+    cache_tris: Vec<FocalTriangle<f32>>,
+    cache_planes: Vec<FocalPlane>,
+    positions: Vec<Vec3>,
+    indices: Vec<[u32; 3]>,
+}
+
+impl Sets {
+    /// Storage for the sets over the first `used` primitives of `frame`.
+    pub fn new(frame: &Frame, used: usize) -> Self {
+        let tris = &frame.tris[..used];
+        Sets {
+            cache_spheres: vec![FocalSphere::gather(&[]); used],
+            cache_tris: vec![FocalTriangle::never(); used],
+            cache_planes: vec![FocalPlane::new(Vec3::ZERO, &Plane::new(Vec3::ZERO, Vec3::Z)); used],
+            positions: tris.iter().flat_map(|t| [t.a(), t.b(), t.c()]).collect(),
+            indices: (0..tris.len() as u32)
+                .map(|i| [3 * i, 3 * i + 1, 3 * i + 2])
+                .collect(),
+        }
+    }
+}
+
+/// Code run with one kernel's two queries: `set`, the library's set of the kernel over the
+/// frame's primitives (the first `used`), or `None` when the kernel has no public set; then
+/// `packets`, the lab's N rays × 1 primitive loop (the kernel alone), and `soa`, the closest
+/// hit of one ray over the primitives packed in lanes.
 pub trait WithKernel<L: Lane> {
     /// What it returns.
     type Output;
     /// Runs with the kernel's queries.
-    fn run(
+    fn run<T: Trace + ?Sized>(
         self,
+        set: Option<&T>,
         packets: impl Fn(&RayPacket<L>) -> Best<L>,
         soa: impl Fn(&Ray) -> Option<HitRecord>,
     ) -> Self::Output;
@@ -429,6 +531,7 @@ impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane_lab::registry::Visitor for
     fn sphere<K: SphereKernel>(self, _: Kernel) -> B::Output {
         let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
         self.body.run(
+            Some(&f.spheres[..u].using::<K>()),
             |r| internals::sphere::closest::<K, _>(r, &f.spheres[..u]),
             |r| internals::sphere::closest_soa::<K, _>(r, &l.spheres),
         )
@@ -441,7 +544,14 @@ impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane_lab::registry::Visitor for
         } else {
             (&f.unguarded, &l.unguarded)
         };
+        // The library's focal spheres are the guarded cache (`FocalSpheres`); the unguarded
+        // kernel, measured for the study, has no public set.
+        let mut s = Sets::new(f, u);
+        let set = guarded
+            .then(|| FocalSpheres::new(&f.spheres[..u], f.cam.eye, &mut s.cache_spheres).ok())
+            .flatten();
         self.body.run(
+            set.as_ref(),
             |r| internals::sphere::focal::closest::<K, _>(r, &cache[..u]),
             |r| internals::sphere::focal::closest_soa::<K, _>(r, packed),
         )
@@ -450,6 +560,7 @@ impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane_lab::registry::Visitor for
     fn plane(self, _: Kernel) -> B::Output {
         let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
         self.body.run(
+            Some(&f.planes[..u]),
             |r| internals::plane::closest(r, &f.planes[..u]),
             |r| internals::plane::closest_soa(r, &l.planes),
         )
@@ -457,8 +568,11 @@ impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane_lab::registry::Visitor for
 
     fn focal_plane(self, _: Kernel) -> B::Output {
         let (f, u) = (self.frame, self.lanes.used);
+        let mut s = Sets::new(f, u);
+        let set = FocalPlanes::new(&f.planes[..u], f.cam.eye, &mut s.cache_planes).ok();
         // No 1 ray × N shape: the packet query of the ray splatted (not run).
         self.body.run(
+            set.as_ref(),
             |r| internals::plane::closest_focal(r, &f.focal_planes[..u]),
             |r| {
                 internals::plane::closest_focal(&RayPacket::<f32>::splat(r), &f.focal_planes[..u])
@@ -470,6 +584,7 @@ impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane_lab::registry::Visitor for
     fn triangle<K: TriangleKernel>(self, _: Kernel) -> B::Output {
         let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
         self.body.run(
+            Some(&f.tris[..u].using::<K>()),
             |r| internals::triangle::closest::<K, _>(r, &f.tris[..u], Cull::None),
             |r| internals::triangle::closest_soa::<K, _>(r, &l.tris, Cull::None),
         )
@@ -477,7 +592,11 @@ impl<L: Lane<Scalar = f32>, B: WithKernel<L>> raylane_lab::registry::Visitor for
 
     fn focal_triangle(self, _: Kernel) -> B::Output {
         let (f, l, u) = (self.frame, self.lanes, self.lanes.used);
+        let mut s = Sets::new(f, u);
+        let mesh = Mesh::new(&s.positions, &s.indices);
+        let set = FocalMesh::new(&mesh, f.cam.eye, &mut s.cache_tris).ok();
         self.body.run(
+            set.as_ref(),
             |r| internals::triangle::focal::closest(r, &f.focal_tris[..u], Cull::None),
             |r| internals::triangle::focal::closest_soa(r, &l.focal_tris, Cull::None),
         )
@@ -498,16 +617,21 @@ pub fn with_kernel<L: Lane<Scalar = f32>, B: WithKernel<L>>(
 /// the number of rays hit.
 pub fn run<L: Lane<Scalar = f32>>(k: Kernel, shape: Shape, frame: &Frame, lanes: &Lanes<L>) -> u32 {
     struct Run<'a, L: Lane>(Shape, &'a Frame, &'a Lanes<L>);
-    impl<L: Lane> WithKernel<L> for Run<'_, L> {
+    impl<L: Lane<Scalar = f32>> WithKernel<L> for Run<'_, L> {
         type Output = u32;
-        fn run(
+        fn run<T: Trace + ?Sized>(
             self,
+            set: Option<&T>,
             p: impl Fn(&RayPacket<L>) -> Best<L>,
             s: impl Fn(&Ray) -> Option<HitRecord>,
         ) -> u32 {
-            match self.0 {
-                Shape::Packets => packets_frame(&self.2.packets, p),
-                Shape::Soa => soa_frame(&self.1.rays, s),
+            match (self.0, set) {
+                (Shape::Packets, Some(set)) if L::LANES == 1 => {
+                    rays_frame(&self.1.rays, |r| set.closest(r))
+                }
+                (Shape::Packets, Some(set)) => packets_frame(&self.2.packets, |r| set.closest(r)),
+                (Shape::Packets, None) => packets_frame(&self.2.packets, p),
+                (Shape::Soa, _) => rays_frame(&self.1.rays, s),
             }
         }
     }
@@ -522,25 +646,36 @@ pub fn answers<L: Lane<Scalar = f32>>(
     lanes: &Lanes<L>,
 ) -> Vec<Option<HitRecord>> {
     struct Answers<'a, L: Lane>(Shape, &'a Frame, &'a Lanes<L>);
+    fn each<L: Lane, A: Answer>(
+        packets: &[RayPacket<L>],
+        rays: usize,
+        f: impl Fn(&RayPacket<L>) -> A,
+    ) -> Vec<Option<HitRecord>> {
+        packets
+            .iter()
+            .flat_map(|r| {
+                let h = f(r);
+                (0..L::LANES).map(move |i| h.record(i))
+            })
+            .take(rays)
+            .collect()
+    }
     impl<L: Lane<Scalar = f32>> WithKernel<L> for Answers<'_, L> {
         type Output = Vec<Option<HitRecord>>;
-        fn run(
+        fn run<T: Trace + ?Sized>(
             self,
+            set: Option<&T>,
             p: impl Fn(&RayPacket<L>) -> Best<L>,
             s: impl Fn(&Ray) -> Option<HitRecord>,
         ) -> Self::Output {
-            match self.0 {
-                Shape::Packets => self
-                    .2
-                    .packets
-                    .iter()
-                    .flat_map(|r| {
-                        let h = p(r);
-                        (0..L::LANES).map(move |i| h.lane(i))
-                    })
-                    .take(self.1.rays.len())
-                    .collect(),
-                Shape::Soa => self.1.rays.iter().map(s).collect(),
+            let (rays, packets) = (&self.1.rays, &self.2.packets);
+            match (self.0, set) {
+                (Shape::Packets, Some(set)) if L::LANES == 1 => {
+                    rays.iter().map(|r| set.closest(r).record(0)).collect()
+                }
+                (Shape::Packets, Some(set)) => each(packets, rays.len(), |r| set.closest(r)),
+                (Shape::Packets, None) => each(packets, rays.len(), p),
+                (Shape::Soa, _) => rays.iter().map(s).collect(),
             }
         }
     }
@@ -557,8 +692,9 @@ pub fn frame_ops(k: Kernel, frame: &Frame, used: usize) -> raylane::opcount::OpC
     struct Count<'a>(&'a Lanes<Counted<f32>>);
     impl WithKernel<Counted<f32>> for Count<'_> {
         type Output = ();
-        fn run(
+        fn run<T: Trace + ?Sized>(
             self,
+            _: Option<&T>,
             p: impl Fn(&RayPacket<Counted<f32>>) -> Best<Counted<f32>>,
             _: impl Fn(&Ray) -> Option<HitRecord>,
         ) {
