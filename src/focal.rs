@@ -444,13 +444,14 @@ impl<'c> FocalPlanes<'c> {
 impl Trace for FocalPlanes<'_> {
     #[inline]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
-        let at = at_eye(rays, self.eye);
+        let eyed = at_eye(rays, self.eye);
         let cull = self.cull;
-        if at.any() {
-            let mut r = only(rays, at);
+        if eyed.any() {
+            let mut r = only(rays, eyed);
             let neg = L::from_f32(f32::NEG_INFINITY);
+            // The collector's upper end changes only when it takes a candidate: read it then.
+            r.t_max = L::select(eyed, c.t_max(), neg);
             for (i, p) in self.cache.iter().enumerate() {
-                r.t_max = L::select(at, c.t_max(), neg);
                 let mut h = p.intersect_lanes(&r);
                 if cull.back() && h.mask.any() {
                     let front = r.dir.dot(V3::splat(p.normal())).lt(L::from_f32(0.0));
@@ -463,12 +464,15 @@ impl Trace for FocalPlanes<'_> {
                 };
                 let record =
                     |w: &Winners<L>| Plane::records(rays, w, cull, |_| self.planes.get(i).copied());
-                if h.mask.any() && c.offer(&h, at, record) {
-                    return true;
+                if h.mask.any() {
+                    if c.offer(&h, at, record) {
+                        return true;
+                    }
+                    r.t_max = L::select(eyed, c.t_max(), neg);
                 }
             }
         }
-        let other = rays.valid().and_not(at);
+        let other = rays.valid().and_not(eyed);
         other.any()
             && flat::<Plane, PlaneTest, L, C>(
                 rays,

@@ -32,7 +32,7 @@
 use glam::Vec3;
 
 use crate::kernel::{Cull, LaneHit, Primitive, plus_zero};
-use crate::lane::{Lane, Mask, Scalar, pow2, select_indices};
+use crate::lane::{Lane, Mask, Scalar, pow2};
 use crate::plane::Plane;
 use crate::ray::RayPacket;
 use crate::sphere::Sphere;
@@ -206,9 +206,9 @@ impl<L: Lane> Winners<L> {
         let h = h.normalized();
         let none = L::indices(u32::MAX);
         let (mut index, mut set, mut loc) = (none, none, none);
-        select_indices::<L>(h.mask, at.index, &mut index);
-        select_indices::<L>(h.mask, at.set, &mut set);
-        select_indices::<L>(h.mask, at.loc, &mut loc);
+        L::select_indices(h.mask, at.index, &mut index);
+        L::select_indices(h.mask, at.set, &mut set);
+        L::select_indices(h.mask, at.loc, &mut loc);
         Winners {
             t: h.t,
             u: h.u,
@@ -344,18 +344,24 @@ impl<L: Lane> Collector<L> for Closest<L> {
         if L::LANES == 1 {
             self.consider(h, at);
         } else {
-            self.consider_lanes(h, at);
+            self.consider_lanes(*h, at);
         }
         false
     }
 }
 
 impl<L: Lane> Closest<L> {
-    /// [`consider`](Self::consider) out of line: for packets, one copy per lane type rather
-    /// than one per kernel and set (the kernels dominate the work; the code is per kernel).
-    #[inline(never)]
-    fn consider_lanes(&mut self, h: &LaneHit<L>, at: At) {
-        self.consider(h, at);
+    /// [`consider`](Self::consider) for packets: inline on x86-64 and AArch64, where a call
+    /// per taken candidate costs more than the kernel (its vector registers saved and
+    /// restored); out of line elsewhere (Cortex-M, RISC-V: their packets are arrays of
+    /// scalars), one copy per lane type rather than one per kernel and set, for code size.
+    #[cfg_attr(any(target_arch = "x86_64", target_arch = "aarch64"), inline(always))]
+    #[cfg_attr(
+        not(any(target_arch = "x86_64", target_arch = "aarch64")),
+        inline(never)
+    )]
+    fn consider_lanes(&mut self, h: LaneHit<L>, at: At) {
+        self.consider(&h, at);
     }
 
     /// The candidates of `h` from `at`: taken where they come first by `(t, set, index)`.
@@ -398,9 +404,9 @@ impl<L: Lane> Closest<L> {
         self.w = L::select(take, h.w, self.w);
         self.mask = self.mask | take;
         self.t_max = L::select(take, relax(h.t), self.t_max);
-        select_indices::<L>(take, at.index, &mut self.index);
-        select_indices::<L>(take, at.set, &mut self.set);
-        select_indices::<L>(take, at.loc, &mut self.loc);
+        L::select_indices(take, at.index, &mut self.index);
+        L::select_indices(take, at.set, &mut self.set);
+        L::select_indices(take, at.loc, &mut self.loc);
     }
 }
 

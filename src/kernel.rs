@@ -139,12 +139,14 @@ pub trait Kernel<P: Primitive> {
     /// The first hit of each ray lane on the primitive in the same lane, inside the lane's
     /// interval (spheres: the entry root, or the exit root from inside with `u = 1`; under
     /// [`Cull::Back`] entry roots only). `u`, `v` may be deferred ([`LaneHit::deferred`]).
+    /// `None` when every lane missed the kernel's first test (its early exit), so that a set
+    /// skips the merge of the answer entirely.
     fn first<L: Lane>(
         rays: &RayPacket<L>,
         pre: &Self::Rays<L>,
         prim: &P::Packet<L>,
         cull: Cull,
-    ) -> LaneHit<L>;
+    ) -> Option<LaneHit<L>>;
     /// Every hit, in order along the rays (spheres: the entry roots, then, unless culled, the
     /// exit roots with `u = 1`), each passed to `f`; stops when `f` returns true, and returns
     /// whether it stopped. By default the [`first`](Self::first) hit alone.
@@ -156,8 +158,7 @@ pub trait Kernel<P: Primitive> {
         cull: Cull,
         mut f: impl FnMut(&LaneHit<L>) -> bool,
     ) -> bool {
-        let h = Self::first(rays, pre, prim, cull);
-        h.mask.any() && f(&h)
+        Self::first(rays, pre, prim, cull).is_some_and(|h| h.mask.any() && f(&h))
     }
 }
 

@@ -235,6 +235,20 @@ pub trait Lane:
     fn from_fn(f: impl FnMut(usize) -> Self::Scalar) -> Self;
     /// Every index set to `v`.
     fn indices(v: u32) -> Self::Indices;
+    /// `b` set to `a` in the lanes of `mask` (the others unchanged): the winners' indices of
+    /// a closest-hit collector. By default lane by lane over `mask`'s bits; packets of `f32`
+    /// lanes blend them as one vector.
+    #[inline(always)]
+    fn select_indices(mask: Self::Mask, a: u32, b: &mut Self::Indices) {
+        let mut bits = mask.bits();
+        let out = b.as_mut();
+        while bits != 0 {
+            if let Some(slot) = out.get_mut(bits.trailing_zeros() as usize) {
+                *slot = a;
+            }
+            bits &= bits - 1;
+        }
+    }
     /// Lane `i` as a single higher-precision lane (exact widening).
     fn precise_lane(self, i: usize) -> Self::Precise;
 
@@ -329,6 +343,24 @@ fn arm_vsqrt(x: f32) -> f32 {
     f32::from_bits(bits)
 }
 
+/// True where `x` is neither NaN nor infinite. Where floating-point arithmetic is hardware
+/// (x86-64, AArch64) as `x − x == 0` (`±0` exactly for every finite `x`, NaN otherwise): one
+/// subtraction and one compare, which LLVM keeps as such (the bit test combines with a
+/// kernel's own compare of the same value into a class test that x86-64 lowers to a dozen
+/// integer instructions). Elsewhere (Cortex-M, RISC-V, possibly without an FPU) the bit
+/// test. The same answer for every input; not counted as floating-point work.
+#[inline(always)]
+fn finite_f32(x: f32) -> bool {
+    #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
+    {
+        x - x == 0.0
+    }
+    #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
+    {
+        x.to_bits() & 0x7f80_0000 != 0x7f80_0000
+    }
+}
+
 impl Lane for f32 {
     const PLAIN_F32: bool = true;
     type Scalar = f32;
@@ -371,7 +403,7 @@ impl Lane for f32 {
     }
     #[inline(always)]
     fn is_finite(self) -> bool {
-        self.to_bits() & 0x7f80_0000 != 0x7f80_0000
+        finite_f32(self)
     }
     #[inline(always)]
     fn lane(self, _i: usize) -> f32 {
@@ -538,7 +570,15 @@ macro_rules! wide_lane {
             }
             #[inline(always)]
             fn is_finite(self) -> Self {
-                $t::is_finite(self)
+                // As for `f32` (see `finite_f32`): `x − x == 0` where arithmetic is hardware.
+                #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
+                {
+                    (self - self).simd_eq($t::ZERO)
+                }
+                #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
+                {
+                    $t::is_finite(self)
+                }
             }
             #[inline(always)]
             fn lane(self, i: usize) -> f32 {
@@ -551,6 +591,12 @@ macro_rules! wide_lane {
             #[inline(always)]
             fn indices(v: u32) -> [u32; $n] {
                 [v; $n]
+            }
+            #[inline(always)]
+            fn select_indices(mask: Self, a: u32, b: &mut [u32; $n]) {
+                // A bitwise blend: the indices travel as the bits of f32 lanes.
+                let old: $t = bytemuck::cast(*b);
+                *b = bytemuck::cast(mask.select($t::splat(f32::from_bits(a)), old));
             }
             #[inline(always)]
             fn precise_lane(self, i: usize) -> f64 {
@@ -604,19 +650,6 @@ fn max16(v: f32x16) -> f32 {
 wide_lane!(f32x4, 4, max4);
 wide_lane!(f32x8, 8, max8);
 wide_lane!(f32x16, 16, max16);
-
-/// `if mask { a } else { b }` for index arrays, lane by lane (only lanes set in `mask` change).
-#[inline(always)]
-pub(crate) fn select_indices<L: Lane>(mask: L::Mask, a: u32, b: &mut L::Indices) {
-    let mut bits = mask.bits();
-    let out = b.as_mut();
-    while bits != 0 {
-        if let Some(slot) = out.get_mut(bits.trailing_zeros() as usize) {
-            *slot = a;
-        }
-        bits &= bits - 1;
-    }
-}
 
 #[cfg(test)]
 mod tests {

@@ -163,13 +163,18 @@ impl Kernel<Plane> for PlaneTest {
     fn prepare<L: Lane>(_: &RayPacket<L>) {}
 
     #[inline(always)]
-    fn first<L: Lane>(rays: &RayPacket<L>, _: &(), p: &PlanePacket<L>, cull: Cull) -> LaneHit<L> {
+    fn first<L: Lane>(
+        rays: &RayPacket<L>,
+        _: &(),
+        p: &PlanePacket<L>,
+        cull: Cull,
+    ) -> Option<LaneHit<L>> {
         let h = intersect_lanes(rays, p);
-        if cull.back() && h.mask.any() {
+        Some(if cull.back() && h.mask.any() {
             let front = rays.dir.dot(p.normal).lt(L::from_f32(0.0));
             LaneHit::new(h.t, h.u, h.v, h.mask & front)
         } else {
             h
-        }
+        })
     }
 }

@@ -262,8 +262,9 @@ pub(crate) fn flat<P: Record, K: Kernel<P>, L: Lane, C: Collector<L>>(
     let pre = K::prepare(&rays);
     let mut r = only(&rays, keep);
     let neg = L::from_f32(f32::NEG_INFINITY);
+    // The collector's upper end changes only when it takes a candidate: read it then.
+    r.t_max = L::select(keep, c.t_max(), neg);
     for (i, p) in prims.into_iter().enumerate() {
-        r.t_max = L::select(keep, c.t_max(), neg);
         let at = At {
             set,
             index: i as u32,
@@ -275,8 +276,15 @@ pub(crate) fn flat<P: Record, K: Kernel<P>, L: Lane, C: Collector<L>>(
                 c.offer(h, at, |w| P::records(&rays, w, cull, |_| Some(p)))
             })
         } else {
-            let h = K::first(&r, &pre, &packet, cull);
-            h.mask.any() && c.offer(&h, at, |w| P::records(&rays, w, cull, |_| Some(p)))
+            let Some(h) = K::first(&r, &pre, &packet, cull) else {
+                continue;
+            };
+            if h.mask.none() {
+                continue;
+            }
+            let stop = c.offer(&h, at, |w| P::records(&rays, w, cull, |_| Some(p)));
+            r.t_max = L::select(keep, c.t_max(), neg);
+            stop
         };
         if stop {
             return true;

@@ -67,17 +67,21 @@ fn with<L: Lane>(rays: &RayPacket<L>, t_max: L) -> RayPacket<L> {
 }
 
 /// N rays × 1 primitive: `test(rays, p)` for the primitives `p` in order (primitive `i` the
-/// `i`-th), the closest hit per lane.
+/// `i`-th), the closest hit per lane. `test` returns `None` when no lane passed the kernel's
+/// early exits; the rays' upper ends follow the collector's only when it took a candidate.
 pub fn closest_with<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: impl IntoIterator<Item = P>,
-    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
 ) -> Best<L> {
     let mut c = Closest::new(rays);
+    let mut r = with(rays, c.t_max());
     for (i, p) in prims.into_iter().enumerate() {
-        let h = test(&with(rays, c.t_max()), p);
-        if h.mask.any() {
+        if let Some(h) = test(&r, p)
+            && h.mask.any()
+        {
             c.offer(&h, at(i), none);
+            r = with(rays, c.t_max());
         }
     }
     c.finish()
@@ -87,12 +91,15 @@ pub fn closest_with<L: Lane, P>(
 pub fn any_with<L: Lane, P>(
     rays: &RayPacket<L>,
     prims: impl IntoIterator<Item = P>,
-    mut test: impl FnMut(&RayPacket<L>, P) -> LaneHit<L>,
+    mut test: impl FnMut(&RayPacket<L>, P) -> Option<LaneHit<L>>,
 ) -> L::Mask {
     let mut c = raylane::hit::Any::new(rays);
+    let r = with(rays, c.t_max());
     for (i, p) in prims.into_iter().enumerate() {
-        let h = test(&with(rays, c.t_max()), p);
-        if h.mask.any() && c.offer(&h, at(i), none) {
+        if let Some(h) = test(&r, p)
+            && h.mask.any()
+            && c.offer(&h, at(i), none)
+        {
             break;
         }
     }
@@ -104,14 +111,20 @@ pub fn any_with<L: Lane, P>(
 pub fn closest_soa_with<L: Lane<Scalar = f32>, P>(
     ray: &Ray,
     chunks: &[P],
-    mut test: impl FnMut(&RayPacket<L>, &P) -> LaneHit<L>,
+    mut test: impl FnMut(&RayPacket<L>, &P) -> Option<LaneHit<L>>,
 ) -> Option<HitRecord> {
     let one = RayPacket::<f32>::splat(ray);
     let lanes = RayPacket::<L>::splat(ray);
     let mut c = Closest::new(&one);
+    let mut r = with(&lanes, L::from_f32(c.t_max()));
     for (k, p) in chunks.iter().enumerate() {
-        let h = test(&with(&lanes, L::from_f32(c.t_max())), p);
+        let Some(h) = test(&r, p) else {
+            continue;
+        };
         let mut bits = h.mask.bits();
+        if bits == 0 {
+            continue;
+        }
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;
@@ -124,6 +137,7 @@ pub fn closest_soa_with<L: Lane<Scalar = f32>, P>(
             };
             c.offer(&h1, at(k * L::LANES + j), none);
         }
+        r = with(&lanes, L::from_f32(c.t_max()));
     }
     c.finish().get()
 }
@@ -132,7 +146,7 @@ pub fn closest_soa_with<L: Lane<Scalar = f32>, P>(
 pub fn any_soa_with<L: Lane<Scalar = f32>, P>(
     ray: &Ray,
     chunks: &[P],
-    mut test: impl FnMut(&RayPacket<L>, &P) -> LaneHit<L>,
+    mut test: impl FnMut(&RayPacket<L>, &P) -> Option<LaneHit<L>>,
 ) -> bool {
     closest_soa_with(ray, chunks, &mut test).is_some()
 }
@@ -160,12 +174,16 @@ pub mod sphere {
 
     /// N rays × 1 sphere.
     pub fn closest<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, s: &[Sphere]) -> Best<L> {
-        closest_with(rays, s, |r, x| K::roots(r, &SpherePacket::splat(x)).first())
+        closest_with(rays, s, |r, x| {
+            K::maybe_roots(r, &SpherePacket::splat(x)).map(|x| x.first())
+        })
     }
 
     /// N rays × 1 sphere: occlusion.
     pub fn any<K: SphereKernel, L: Lane>(rays: &RayPacket<L>, s: &[Sphere]) -> L::Mask {
-        any_with(rays, s, |r, x| K::roots(r, &SpherePacket::splat(x)).first())
+        any_with(rays, s, |r, x| {
+            K::maybe_roots(r, &SpherePacket::splat(x)).map(|x| x.first())
+        })
     }
 
     /// Every root of every sphere: `f(index, roots)` for each sphere some lane hits.
@@ -187,7 +205,7 @@ pub mod sphere {
         ray: &Ray,
         s: &[SpherePacket<L>],
     ) -> Option<HitRecord> {
-        closest_soa_with(ray, s, |r, p| K::roots(r, p).first())
+        closest_soa_with(ray, s, |r, p| K::maybe_roots(r, p).map(|x| x.first()))
     }
 
     /// 1 ray × spheres packed in lanes: occlusion.
@@ -195,7 +213,7 @@ pub mod sphere {
         ray: &Ray,
         s: &[SpherePacket<L>],
     ) -> bool {
-        any_soa_with(ray, s, |r, p| K::roots(r, p).first())
+        any_soa_with(ray, s, |r, p| K::maybe_roots(r, p).map(|x| x.first()))
     }
 
     /// Loops over sphere focal caches (rays from the cache's eye, unit directions).
@@ -210,7 +228,9 @@ pub mod sphere {
             rays: &RayPacket<L>,
             cache: &[FocalSphere<f32>],
         ) -> Best<L> {
-            closest_with(rays, cache, |r, e| K::roots(r, &Splat(e)).first())
+            closest_with(rays, cache, |r, e| {
+                K::maybe_roots(r, &Splat(e)).map(|x| x.first())
+            })
         }
 
         /// N rays × 1 entry: occlusion.
@@ -218,7 +238,9 @@ pub mod sphere {
             rays: &RayPacket<L>,
             cache: &[FocalSphere<f32>],
         ) -> L::Mask {
-            any_with(rays, cache, |r, e| K::roots(r, &Splat(e)).first())
+            any_with(rays, cache, |r, e| {
+                K::maybe_roots(r, &Splat(e)).map(|x| x.first())
+            })
         }
 
         /// Every root of every entry some lane hits: `f(index, roots)`.
@@ -240,7 +262,7 @@ pub mod sphere {
             ray: &Ray,
             cache: &[FocalSphere<L>],
         ) -> Option<HitRecord> {
-            closest_soa_with(ray, cache, |r, e| K::roots(r, e).first())
+            closest_soa_with(ray, cache, |r, e| K::maybe_roots(r, e).map(|x| x.first()))
         }
 
         /// 1 ray × entries packed in lanes: occlusion.
@@ -248,7 +270,7 @@ pub mod sphere {
             ray: &Ray,
             cache: &[FocalSphere<L>],
         ) -> bool {
-            any_soa_with(ray, cache, |r, e| K::roots(r, e).first())
+            any_soa_with(ray, cache, |r, e| K::maybe_roots(r, e).map(|x| x.first()))
         }
     }
 }
@@ -272,7 +294,7 @@ pub mod triangle {
     ) -> Best<L> {
         let pre = K::prepare(rays);
         closest_with(rays, t, |r, x| {
-            K::intersect(r, &pre, &TrianglePacket::splat(x), cull)
+            K::maybe_intersect(r, &pre, &TrianglePacket::splat(x), cull)
         })
     }
 
@@ -284,7 +306,7 @@ pub mod triangle {
     ) -> L::Mask {
         let pre = K::prepare(rays);
         any_with(rays, t, |r, x| {
-            K::intersect(r, &pre, &TrianglePacket::splat(x), cull)
+            K::maybe_intersect(r, &pre, &TrianglePacket::splat(x), cull)
         })
     }
 
@@ -311,7 +333,7 @@ pub mod triangle {
         cull: Cull,
     ) -> Option<HitRecord> {
         let pre = K::prepare(&RayPacket::<L>::splat(ray));
-        closest_soa_with(ray, t, |r, p| K::intersect(r, &pre, p, cull))
+        closest_soa_with(ray, t, |r, p| K::maybe_intersect(r, &pre, p, cull))
     }
 
     /// 1 ray × triangles packed in lanes: occlusion.
@@ -321,14 +343,14 @@ pub mod triangle {
         cull: Cull,
     ) -> bool {
         let pre = K::prepare(&RayPacket::<L>::splat(ray));
-        any_soa_with(ray, t, |r, p| K::intersect(r, &pre, p, cull))
+        any_soa_with(ray, t, |r, p| K::maybe_intersect(r, &pre, p, cull))
     }
 
     /// Loops over triangle focal caches (rays from the cache's eye).
     pub mod focal {
         use super::*;
         use raylane::triangle::FocalTriangle;
-        use raylane::triangle::focal::{FocalRays, Splat, kernel};
+        use raylane::triangle::focal::{FocalRays, Splat, kernel, maybe_hit};
         pub use raylane::triangle::focal::{focus, intersect_lanes};
 
         /// One ray from the eye and one entry.
@@ -344,7 +366,7 @@ pub mod triangle {
             cull: Cull,
         ) -> Best<L> {
             let fr = FocalRays::new(rays);
-            let mut w = closest_with(fr.scaled(), cache, |r, e| kernel(r, &Splat(e), cull));
+            let mut w = closest_with(fr.scaled(), cache, |r, e| maybe_hit(r, &Splat(e), cull));
             w.t = fr.own_units(w.t);
             w
         }
@@ -356,7 +378,7 @@ pub mod triangle {
             cull: Cull,
         ) -> L::Mask {
             let fr = FocalRays::new(rays);
-            any_with(fr.scaled(), cache, |r, e| kernel(r, &Splat(e), cull))
+            any_with(fr.scaled(), cache, |r, e| maybe_hit(r, &Splat(e), cull))
         }
 
         /// Every hit: `f(index, hit)` (divided, `t` in the rays' own units).
@@ -383,7 +405,7 @@ pub mod triangle {
         ) -> Option<HitRecord> {
             let fr = FocalRays::<f32>::new(&RayPacket::splat(ray));
             let scaled = fr.scaled().ray(0);
-            closest_soa_with(&scaled, cache, |r, e| kernel(r, e, cull)).map(|h| HitRecord {
+            closest_soa_with(&scaled, cache, |r, e| maybe_hit(r, e, cull)).map(|h| HitRecord {
                 t: fr.own_units(h.t),
                 ..h
             })
@@ -396,7 +418,7 @@ pub mod triangle {
             cull: Cull,
         ) -> bool {
             let fr = FocalRays::<f32>::new(&RayPacket::splat(ray));
-            any_soa_with(&fr.scaled().ray(0), cache, |r, e| kernel(r, e, cull))
+            any_soa_with(&fr.scaled().ray(0), cache, |r, e| maybe_hit(r, e, cull))
         }
     }
 }
@@ -417,12 +439,16 @@ pub mod plane {
 
     /// N rays × 1 plane.
     pub fn closest<L: Lane>(rays: &RayPacket<L>, p: &[Plane]) -> Best<L> {
-        closest_with(rays, p, |r, x| intersect_lanes(r, &PlanePacket::splat(x)))
+        closest_with(rays, p, |r, x| {
+            Some(intersect_lanes(r, &PlanePacket::splat(x)))
+        })
     }
 
     /// N rays × 1 plane: occlusion.
     pub fn any<L: Lane>(rays: &RayPacket<L>, p: &[Plane]) -> L::Mask {
-        any_with(rays, p, |r, x| intersect_lanes(r, &PlanePacket::splat(x)))
+        any_with(rays, p, |r, x| {
+            Some(intersect_lanes(r, &PlanePacket::splat(x)))
+        })
     }
 
     /// Every plane some lane hits: `f(index, hit)`.
@@ -437,7 +463,7 @@ pub mod plane {
 
     /// N rays from the eye × 1 cached plane.
     pub fn closest_focal<L: Lane>(rays: &RayPacket<L>, cache: &[FocalPlane]) -> Best<L> {
-        closest_with(rays, cache, |r, e| e.intersect_lanes(r))
+        closest_with(rays, cache, |r, e| Some(e.intersect_lanes(r)))
     }
 
     /// 1 ray × planes packed in lanes.
@@ -445,6 +471,6 @@ pub mod plane {
         ray: &Ray,
         p: &[PlanePacket<L>],
     ) -> Option<HitRecord> {
-        closest_soa_with(ray, p, |r, x| intersect_lanes(r, x))
+        closest_soa_with(ray, p, |r, x| Some(intersect_lanes(r, x)))
     }
 }

@@ -498,7 +498,12 @@ mod timed {
         tp: &TrianglePacket<L>,
     ) -> u32 {
         let rec = K::precompute(tp);
-        tests(n, &rec, |r| K::test(rp, r, Cull::None), lane_hits)
+        tests(
+            n,
+            &rec,
+            |r| K::test(rp, r, Cull::None).unwrap_or_else(raylane::kernel::LaneHit::miss),
+            lane_hits,
+        )
     }
 
     /// A sphere kernel's roots.

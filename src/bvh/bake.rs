@@ -447,7 +447,10 @@ impl Baked<'_> {
                 let pre = pre.get_or_insert_with(|| K::prepare(&r1));
                 for t in first..first + count {
                     let r = r1.shrink(true, c.t_max());
-                    let h = K::first(&r, pre, &TrianglePacket::splat(&self.triangle(t)), cull);
+                    let tri = TrianglePacket::splat(&self.triangle(t));
+                    let Some(h) = K::first(&r, pre, &tri, cull) else {
+                        continue;
+                    };
                     let at = At {
                         set,
                         index: self.id(t),
@@ -478,7 +481,9 @@ impl Baked<'_> {
                     r4
                 };
                 let pre = pre.get_or_insert_with(|| K::prepare(&r4));
-                let h = K::first(&r, pre, &four, cull);
+                let Some(h) = K::first(&r, pre, &four, cull) else {
+                    return false;
+                };
                 let mut bits = h.mask.bits();
                 while bits != 0 {
                     let j = bits.trailing_zeros() as usize;
@@ -549,8 +554,8 @@ impl Set for Baked<'_> {
                     let stop = if C::EVERY {
                         K::each(&r, &pre, &p, cull, |h| c.offer(h, at, record))
                     } else {
-                        let h = K::first(&r, &pre, &p, cull);
-                        h.mask.any() && c.offer(&h, at, record)
+                        K::first(&r, &pre, &p, cull)
+                            .is_some_and(|h| h.mask.any() && c.offer(&h, at, record))
                     };
                     if stop {
                         return true;

@@ -581,7 +581,9 @@ impl<P: Leaf, N: Layout> Bvh<'_, P, N> {
                     r4
                 };
                 let pre = pre.get_or_insert_with(|| K::prepare(&r4));
-                let h = K::first(&r, pre, &leaf.four(), cull);
+                let Some(h) = K::first(&r, pre, &leaf.four(), cull) else {
+                    return false;
+                };
                 let mut bits = h.mask.bits();
                 while bits != 0 {
                     let j = bits.trailing_zeros() as usize;
@@ -745,8 +747,7 @@ pub(crate) fn leaf_many<P: Leaf, K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
         let stop = if C::EVERY {
             K::each(&r, pre, &p, cull, |h| c.offer(h, at, record))
         } else {
-            let h = K::first(&r, pre, &p, cull);
-            h.mask.any() && c.offer(&h, at, record)
+            K::first(&r, pre, &p, cull).is_some_and(|h| h.mask.any() && c.offer(&h, at, record))
         };
         if stop {
             return true;

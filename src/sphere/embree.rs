@@ -35,7 +35,7 @@ impl SphereKernel for EmbreeSphere {
     const NAME: &'static str = "embree";
     const UNIT_DIRECTIONS: bool = false;
     #[inline(always)]
-    fn roots<L: Lane>(ray: &RayPacket<L>, s: &SpherePacket<L>) -> Roots<L> {
+    fn maybe_roots<L: Lane>(ray: &RayPacket<L>, s: &SpherePacket<L>) -> Option<Roots<L>> {
         let d = ray.dir;
         // 1. Per ray: 1/(d·d).
         let k = L::from_f32(1.0) / d.length_squared();
@@ -47,10 +47,10 @@ impl SphereKernel for EmbreeSphere {
         let r2 = s.radius * s.radius;
         let real = l2.le(r2);
         if real.none() {
-            return Roots::miss();
+            return None;
         }
         // 3. The half chord and the two roots.
         let h = ((r2 - l2) * k).sqrt();
-        Roots::in_interval(ray, tau - h, tau + h, real)
+        Some(Roots::in_interval(ray, tau - h, tau + h, real))
     }
 }

@@ -70,13 +70,13 @@ impl Geometric {
     #[inline(always)]
     #[must_use]
     pub fn roots_prepared<L: Lane>(ray: &RayPacket<L>, p: &Prepared<L>) -> Roots<L> {
-        let (roots, _) = Self::body(ray, p);
-        roots
+        Self::body(ray, p).map_or_else(Roots::miss, |(roots, _)| roots)
     }
 
-    /// The body: the roots of lanes in range, and the lanes the range guard sent away.
+    /// The body: the roots of lanes in range, and the lanes the range guard sent away; `None`
+    /// when no lane has real roots.
     #[inline(always)]
-    fn body<L: Lane>(ray: &RayPacket<L>, p: &Prepared<L>) -> (Roots<L>, L::Mask) {
+    fn body<L: Lane>(ray: &RayPacket<L>, p: &Prepared<L>) -> Option<(Roots<L>, L::Mask)> {
         // 1. Foot of the perpendicular along the ray.
         let v = p.t.dot(ray.dir);
         // 2. Squared distance from the centre to the ray, against r².
@@ -85,15 +85,15 @@ impl Geometric {
         // guard (`is_finite` is a bit test, not counted).
         let real = !p.r2.lt(b2) | !b2.is_finite();
         if real.none() {
-            return (Roots::miss(), real);
+            return None;
         }
         // 3. Half chord and both roots, for lanes inside the range.
         let escaped = super::escaped(real, None, p.r2, p.c2);
         let d = (p.r2 - b2).sqrt();
-        (
+        Some((
             Roots::in_interval(ray, v - d, v + d, real.and_not(escaped)),
             escaped,
-        )
+        ))
     }
 }
 
@@ -101,8 +101,8 @@ impl SphereKernel for Geometric {
     const NAME: &'static str = "geometric";
     const UNIT_DIRECTIONS: bool = true;
     #[inline(always)]
-    fn roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Roots<L> {
-        let (roots, escaped) = Geometric::body(ray, &Geometric::prepare(ray.origin, sphere));
-        super::with_fallback(ray, sphere, roots, escaped)
+    fn maybe_roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Option<Roots<L>> {
+        let (roots, escaped) = Geometric::body(ray, &Geometric::prepare(ray.origin, sphere))?;
+        Some(super::with_fallback(ray, sphere, roots, escaped))
     }
 }

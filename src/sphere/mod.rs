@@ -302,8 +302,15 @@ pub trait SphereKernel {
     /// True when the method needs unit-length directions.
     const UNIT_DIRECTIONS: bool;
     /// All roots of each ray lane against the sphere in the same lane, ascending, inside the
+    /// ray's interval, or `None` when no lane has real roots: the miss path's early exit, so
+    /// that a caller skips the merge of the answer entirely.
+    fn maybe_roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Option<Roots<L>>;
+    /// All roots of each ray lane against the sphere in the same lane, ascending, inside the
     /// ray's interval.
-    fn roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Roots<L>;
+    #[inline(always)]
+    fn roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Roots<L> {
+        Self::maybe_roots(ray, sphere).unwrap_or_else(Roots::miss)
+    }
 }
 
 /// Lower end of the squared magnitudes the f32 kernels accept on their fast path (`2^-60`).
@@ -478,8 +485,13 @@ impl<K: SphereKernel> Kernel<Sphere> for K {
     fn prepare<L: Lane>(_: &RayPacket<L>) {}
 
     #[inline(always)]
-    fn first<L: Lane>(rays: &RayPacket<L>, _: &(), s: &SpherePacket<L>, cull: Cull) -> LaneHit<L> {
-        first_root(&K::roots(rays, s), cull)
+    fn first<L: Lane>(
+        rays: &RayPacket<L>,
+        _: &(),
+        s: &SpherePacket<L>,
+        cull: Cull,
+    ) -> Option<LaneHit<L>> {
+        K::maybe_roots(rays, s).map(|r| first_root(&r, cull))
     }
 
     #[inline(always)]
@@ -490,7 +502,7 @@ impl<K: SphereKernel> Kernel<Sphere> for K {
         cull: Cull,
         f: impl FnMut(&LaneHit<L>) -> bool,
     ) -> bool {
-        each_root(&K::roots(rays, s), cull, f)
+        K::maybe_roots(rays, s).is_some_and(|r| each_root(&r, cull, f))
     }
 }
 

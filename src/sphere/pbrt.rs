@@ -36,7 +36,7 @@ impl SphereKernel for Pbrt {
     const NAME: &'static str = "pbrt";
     const UNIT_DIRECTIONS: bool = false;
     #[inline(always)]
-    fn roots<L: Lane>(ray: &RayPacket<L>, s: &SpherePacket<L>) -> Roots<L> {
+    fn maybe_roots<L: Lane>(ray: &RayPacket<L>, s: &SpherePacket<L>) -> Option<Roots<L>> {
         let d = ray.dir;
         let (zero, half, two) = (L::from_f32(0.0), L::from_f32(0.5), L::from_f32(2.0));
         // 1. Object space (a translation), and the quadratic's coefficients.
@@ -50,13 +50,18 @@ impl SphereKernel for Pbrt {
         let disc = L::from_f32(4.0) * a * (s.radius + l) * (s.radius - l);
         let real = disc.ge(zero);
         if real.none() {
-            return Roots::miss();
+            return None;
         }
         // 3. Stable roots, ordered by a compare.
         let root = disc.sqrt();
         let q = -(half * (b + L::select(b.lt(zero), -root, root)));
         let (t0, t1) = (q / a, c / q);
         let swap = t0.gt(t1);
-        Roots::in_interval(ray, L::select(swap, t1, t0), L::select(swap, t0, t1), real)
+        Some(Roots::in_interval(
+            ray,
+            L::select(swap, t1, t0),
+            L::select(swap, t0, t1),
+            real,
+        ))
     }
 }

@@ -59,7 +59,10 @@ pub struct QuadraticUnit;
 
 /// One body for both: `UNIT` skips `a = d·d` and the divisions.
 #[inline(always)]
-fn quadratic<L: Lane, const UNIT: bool>(ray: &RayPacket<L>, s: &SpherePacket<L>) -> Roots<L> {
+fn quadratic<L: Lane, const UNIT: bool>(
+    ray: &RayPacket<L>,
+    s: &SpherePacket<L>,
+) -> Option<Roots<L>> {
     // 1. Base to centre and the half linear coefficient.
     let t = s.center - ray.origin;
     let mu = ray.dir.dot(t);
@@ -74,11 +77,16 @@ fn quadratic<L: Lane, const UNIT: bool>(ray: &RayPacket<L>, s: &SpherePacket<L>)
     };
     let delta = if UNIT { mu * mu - c } else { mu * mu - a * c };
     // `!(δ < 0)`: a NaN or infinite δ (squares that overflowed) goes on to the range guard,
-    // unless the sphere is invalid or padding (NaN radius), so that such lanes keep the early
-    // exit (`is_finite` is a bit test, not counted).
-    let real = (!delta.lt(L::from_f32(0.0)) | !delta.is_finite()) & s.radius.is_finite();
+    // unless the sphere is invalid or padding (NaN radius): such lanes are dropped after the
+    // early exit, which the common miss thus takes on one compare (`is_finite` is a bit
+    // test, not counted).
+    let real = !delta.lt(L::from_f32(0.0)) | !delta.is_finite();
     if real.none() {
-        return Roots::miss();
+        return None;
+    }
+    let real = real & s.radius.is_finite();
+    if real.none() {
+        return None;
     }
     // 3. Both roots, ascending.
     let root = delta.sqrt();
@@ -90,14 +98,14 @@ fn quadratic<L: Lane, const UNIT: bool>(ray: &RayPacket<L>, s: &SpherePacket<L>)
     let roots = Roots::in_interval(ray, lo, hi, real);
     // 4. The range guard: lanes whose scale left f32's safe range, recomputed in f64.
     let escaped = super::escaped(real, (!UNIT).then_some(a), r2, tt);
-    super::with_fallback(ray, s, roots, escaped)
+    Some(super::with_fallback(ray, s, roots, escaped))
 }
 
 impl SphereKernel for Quadratic {
     const NAME: &'static str = "quadratic";
     const UNIT_DIRECTIONS: bool = false;
     #[inline(always)]
-    fn roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Roots<L> {
+    fn maybe_roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Option<Roots<L>> {
         quadratic::<L, false>(ray, sphere)
     }
 }
@@ -106,7 +114,7 @@ impl SphereKernel for QuadraticUnit {
     const NAME: &'static str = "quadratic-unit";
     const UNIT_DIRECTIONS: bool = true;
     #[inline(always)]
-    fn roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Roots<L> {
+    fn maybe_roots<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>) -> Option<Roots<L>> {
         quadratic::<L, true>(ray, sphere)
     }
 }

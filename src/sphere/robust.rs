@@ -44,7 +44,7 @@ impl SphereKernel for Robust {
     const NAME: &'static str = "robust";
     const UNIT_DIRECTIONS: bool = false;
     #[inline(always)]
-    fn roots<L: Lane>(ray: &RayPacket<L>, s: &SpherePacket<L>) -> Roots<L> {
+    fn maybe_roots<L: Lane>(ray: &RayPacket<L>, s: &SpherePacket<L>) -> Option<Roots<L>> {
         let d = ray.dir;
         // 1. Centre to origin, a = d·d, β = −f·d.
         let f = ray.origin - s.center;
@@ -55,11 +55,16 @@ impl SphereKernel for Robust {
         let r2 = s.radius * s.radius;
         let disc = a * (r2 - l.length_squared());
         // `!(Δ < 0)`: a NaN or infinite Δ (squares that overflowed) goes on to the range
-        // guard, unless the sphere is invalid or padding (NaN radius), so that such lanes
-        // keep the early exit (`is_finite` is a bit test, not counted).
-        let real = (!disc.lt(L::from_f32(0.0)) | !disc.is_finite()) & s.radius.is_finite();
+        // guard, unless the sphere is invalid or padding (NaN radius): such lanes are dropped
+        // after the early exit, which the common miss thus takes on one compare
+        // (`is_finite` is a bit test, not counted).
+        let real = !disc.lt(L::from_f32(0.0)) | !disc.is_finite();
         if real.none() {
-            return Roots::miss();
+            return None;
+        }
+        let real = real & s.radius.is_finite();
+        if real.none() {
+            return None;
         }
         // 3. Stable roots: q never cancels; the smaller root is c/q when β ≥ 0.
         let ff = f.length_squared();
@@ -75,6 +80,6 @@ impl SphereKernel for Robust {
         let roots = Roots::in_interval(ray, lo, hi, real);
         // 5. The range guard: lanes whose scale left f32's safe range, recomputed in f64.
         let escaped = super::escaped(real, Some(a), r2, ff);
-        super::with_fallback(ray, s, roots, escaped)
+        Some(super::with_fallback(ray, s, roots, escaped))
     }
 }

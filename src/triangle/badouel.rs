@@ -76,7 +76,7 @@ impl PrecomputedKernel for Badouel {
     }
 
     #[inline(always)]
-    fn test<L: Lane>(ray: &RayPacket<L>, r: &BadouelRecord<L>, cull: Cull) -> LaneHit<L> {
+    fn test<L: Lane>(ray: &RayPacket<L>, r: &BadouelRecord<L>, cull: Cull) -> Option<LaneHit<L>> {
         let (zero, one) = (L::from_f32(0.0), L::from_f32(1.0));
         // 1. The plane: t = (N·A − N·o)/(N·d), strictly inside the interval. Front faces
         //    have N·d < 0.
@@ -87,7 +87,7 @@ impl PrecomputedKernel for Badouel {
             mask = mask & den.lt(zero);
         }
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 2. The hit point relative to A on the projection axes, and the projected edges.
         let (o, d) = (cyclic(r.k, ray.origin), cyclic(r.k, ray.dir));
@@ -100,11 +100,11 @@ impl PrecomputedKernel for Badouel {
         let beta = (e1u * pv - e1v * pu) / det;
         mask = mask & beta.ge(zero) & beta.le(one);
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 4. α, the weight of B: α ≥ 0 and α + β ≤ 1.
         let alpha = (pu * e2v - pv * e2u) / det;
         mask = mask & alpha.ge(zero) & (alpha + beta).le(one);
-        LaneHit::new(t, alpha, beta, mask)
+        Some(LaneHit::new(t, alpha, beta, mask))
     }
 }

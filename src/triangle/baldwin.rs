@@ -92,7 +92,7 @@ impl PrecomputedKernel for BaldwinWeber {
     }
 
     #[inline(always)]
-    fn test<L: Lane>(ray: &RayPacket<L>, m: &AffineRecord<L>, cull: Cull) -> LaneHit<L> {
+    fn test<L: Lane>(ray: &RayPacket<L>, m: &AffineRecord<L>, cull: Cull) -> Option<LaneHit<L>> {
         let (zero, one) = (L::from_f32(0.0), L::from_f32(1.0));
         // 1. The plane in transformed coordinates: t = −z'(o)/z'(d). Front faces: z'(d) < 0.
         let s = m.rows[2].dot(ray.origin) + m.w[2];
@@ -103,13 +103,13 @@ impl PrecomputedKernel for BaldwinWeber {
             mask = mask & e.lt(zero);
         }
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 2. The hit point, transformed: its x', y' are the barycentrics of B and C.
         let p = ray.origin.along(ray.dir, t);
         let u = m.rows[0].dot(p) + m.w[0];
         let v = m.rows[1].dot(p) + m.w[1];
         mask = mask & u.ge(zero) & v.ge(zero) & (u + v).le(one);
-        LaneHit::new(t, u, v, mask)
+        Some(LaneHit::new(t, u, v, mask))
     }
 }

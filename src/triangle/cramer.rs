@@ -43,12 +43,12 @@ impl TriangleKernel for Cramer {
     fn prepare<L: Lane>(_: &RayPacket<L>) -> Self::Rays<L> {}
 
     #[inline(always)]
-    fn intersect<L: Lane>(
+    fn maybe_intersect<L: Lane>(
         ray: &RayPacket<L>,
         _: &(),
         tri: &TrianglePacket<L>,
         cull: Cull,
-    ) -> LaneHit<L> {
+    ) -> Option<LaneHit<L>> {
         let (zero, one) = (L::from_f32(0.0), L::from_f32(1.0));
         // 1. The columns of the system: A − B, A − C and the right-hand side A − o.
         let e1 = tri.a - tri.b;
@@ -63,23 +63,23 @@ impl TriangleKernel for Cramer {
             den.abs().gt(zero)
         };
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 3. β = det[s e2 d]/D, the weight of B, in [0, 1].
         let beta = s.dot(m) / den;
         mask = mask & beta.ge(zero) & beta.le(one);
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 4. γ = det[e1 s d]/D, the weight of C: γ ≥ 0 and β + γ ≤ 1.
         let gamma = e1.dot(s.cross(ray.dir)) / den;
         mask = mask & gamma.ge(zero) & (beta + gamma).le(one);
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 5. t = det[e1 e2 s]/D inside the open interval.
         let t = s.dot(e1.cross(e2)) / den;
         mask = mask & t.gt(ray.t_min) & t.lt(ray.t_max);
-        LaneHit::new(t, beta, gamma, mask)
+        Some(LaneHit::new(t, beta, gamma, mask))
     }
 }

@@ -698,7 +698,7 @@ pub(crate) fn candidate<L: Lane, F: FocalTriangleLanes<L>>(
 /// the closest/any loops skip their merge.
 #[inline(always)]
 #[must_use]
-pub(crate) fn maybe_hit<L: Lane, F: FocalTriangleLanes<L>>(
+pub fn maybe_hit<L: Lane, F: FocalTriangleLanes<L>>(
     ray: &RayPacket<L>,
     f: &F,
     cull: Cull,
@@ -750,7 +750,7 @@ pub(crate) fn maybe_hit<L: Lane, F: FocalTriangleLanes<L>>(
     let det = L::select(front, -dn, dn);
     let den = L::select(det.gt(L::from_f32(0.0)), det, x_uv + e_bc.abs());
     let w = L::select(x_uv.gt(den), x_uv, den);
-    Some(within(ray, mask, num_t, den, x_ca, x_ab, w))
+    within(ray, mask, num_t, den, x_ca, x_ab, w)
 }
 
 /// Decides the `doubtful` lanes with exact edge signs (simulation of simplicity for zeros).

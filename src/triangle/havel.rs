@@ -76,7 +76,7 @@ impl PrecomputedKernel for HavelHerout {
     }
 
     #[inline(always)]
-    fn test<L: Lane>(ray: &RayPacket<L>, r: &PlanesRecord<L>, cull: Cull) -> LaneHit<L> {
+    fn test<L: Lane>(ray: &RayPacket<L>, r: &PlanesRecord<L>, cull: Cull) -> Option<LaneHit<L>> {
         let zero = L::from_f32(0.0);
         // 1. The determinant and the scaled distance.
         let det = r.n0.dot(ray.dir);
@@ -96,7 +96,7 @@ impl PrecomputedKernel for HavelHerout {
             mask = mask & front;
         }
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 4. The interval, then the one division.
         resolve(ray, mask, sgn(tn), us, vs, ad)

@@ -41,12 +41,12 @@ impl TriangleKernel for KenslerShirley {
     fn prepare<L: Lane>(_: &RayPacket<L>) -> Self::Rays<L> {}
 
     #[inline(always)]
-    fn intersect<L: Lane>(
+    fn maybe_intersect<L: Lane>(
         ray: &RayPacket<L>,
         _: &(),
         tri: &TrianglePacket<L>,
         cull: Cull,
-    ) -> LaneHit<L> {
+    ) -> Option<LaneHit<L>> {
         let (zero, one) = (L::from_f32(0.0), L::from_f32(1.0));
         // 1. Edges, normal, and the one reciprocal.
         let e0 = tri.b - tri.a;
@@ -64,11 +64,11 @@ impl TriangleKernel for KenslerShirley {
             mask = mask & den.lt(zero);
         }
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 3. The distance, strictly inside the interval.
         let t = n.dot(c) * k;
         mask = mask & t.gt(ray.t_min) & t.lt(ray.t_max);
-        LaneHit::new(t, u, v, mask)
+        Some(LaneHit::new(t, u, v, mask))
     }
 }

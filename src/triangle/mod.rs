@@ -294,12 +294,23 @@ pub trait TriangleKernel {
     ///
     /// The kernels that defer their division return `u`, `v` still scaled by the determinant:
     /// call [`LaneHit::normalized`] before reading them (the entry points of this module do).
+    #[inline(always)]
     fn intersect<L: Lane>(
         ray: &RayPacket<L>,
         pre: &Self::Rays<L>,
         tri: &TrianglePacket<L>,
         cull: Cull,
-    ) -> LaneHit<L>;
+    ) -> LaneHit<L> {
+        Self::maybe_intersect(ray, pre, tri, cull).unwrap_or_else(LaneHit::miss)
+    }
+    /// The same, or `None` when every lane failed one of the kernel's tests (its early exits:
+    /// a caller then skips the merge of the answer entirely).
+    fn maybe_intersect<L: Lane>(
+        ray: &RayPacket<L>,
+        pre: &Self::Rays<L>,
+        tri: &TrianglePacket<L>,
+        cull: Cull,
+    ) -> Option<LaneHit<L>>;
 }
 
 /// The steps shared by the deferred-division kernels, for lanes in `mask` whose edge tests
@@ -332,10 +343,10 @@ pub(crate) fn resolve<L: Lane>(
     num_u: L,
     num_v: L,
     den: L,
-) -> LaneHit<L> {
+) -> Option<LaneHit<L>> {
     let mask = in_front(ray, mask, num_t);
     if mask.none() {
-        return LaneHit::miss();
+        return None;
     }
     within(ray, mask, num_t, den, num_u, num_v, den)
 }
@@ -362,12 +373,12 @@ pub(crate) fn within<L: Lane>(
     num_u: L,
     num_v: L,
     w: L,
-) -> LaneHit<L> {
+) -> Option<LaneHit<L>> {
     let bound = ray.t_max * den;
     // A subnormal product carries an absolute rounding error: decide those lanes on `t`.
     let mask = mask & (num_t.lt(bound) | bound.lt(L::from_f32(f32::MIN_POSITIVE)));
     if mask.none() {
-        return LaneHit::miss();
+        return None;
     }
     let t = num_t / den;
     // Below `2^-100` the products that make `det` and the numerators have under-flowed: a
@@ -378,7 +389,7 @@ pub(crate) fn within<L: Lane>(
         & den.ge(L::from_f32(MIN_DET))
         & num_u.is_finite()
         & num_v.is_finite();
-    LaneHit::deferred(t, num_u, num_v, w, mask)
+    Some(LaneHit::deferred(t, num_u, num_v, w, mask))
 }
 
 impl Primitive for Triangle {
@@ -405,7 +416,7 @@ impl<K: TriangleKernel> Kernel<Triangle> for K {
         pre: &K::Rays<L>,
         tri: &TrianglePacket<L>,
         cull: Cull,
-    ) -> LaneHit<L> {
-        K::intersect(rays, pre, tri, cull)
+    ) -> Option<LaneHit<L>> {
+        K::maybe_intersect(rays, pre, tri, cull)
     }
 }

@@ -45,12 +45,12 @@ impl TriangleKernel for Moller {
     fn prepare<L: Lane>(_: &RayPacket<L>) -> Self::Rays<L> {}
 
     #[inline(always)]
-    fn intersect<L: Lane>(
+    fn maybe_intersect<L: Lane>(
         ray: &RayPacket<L>,
         _: &(),
         tri: &TrianglePacket<L>,
         cull: Cull,
-    ) -> LaneHit<L> {
+    ) -> Option<LaneHit<L>> {
         let zero = L::from_f32(0.0);
         // 1. Edges from A and the determinant det = e1·(d × e2).
         let e1 = tri.b - tri.a;
@@ -71,7 +71,7 @@ impl TriangleKernel for Moller {
             mask = mask.and_not(back);
         }
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 4. Distance numerator T = e2·q (= t·det); the interval, then the one division.
         let t = e2.dot(q);

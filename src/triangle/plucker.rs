@@ -55,12 +55,12 @@ impl TriangleKernel for Plucker {
     fn prepare<L: Lane>(_: &RayPacket<L>) -> Self::Rays<L> {}
 
     #[inline(always)]
-    fn intersect<L: Lane>(
+    fn maybe_intersect<L: Lane>(
         ray: &RayPacket<L>,
         _: &(),
         tri: &TrianglePacket<L>,
         cull: Cull,
-    ) -> LaneHit<L> {
+    ) -> Option<LaneHit<L>> {
         let zero = L::from_f32(0.0);
         let d = ray.dir;
         // 1. Vertices relative to the origin, and the edges.
@@ -86,7 +86,7 @@ impl TriangleKernel for Plucker {
             front | (u.ge(neps) & v.ge(neps) & w.ge(neps))
         };
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 3. Normal, denominator, distance numerator. The edge values get the sign of
         //    U + V + W folded in and are clamped at zero (the widening lets them reach −ε), so
@@ -105,11 +105,11 @@ impl TriangleKernel for Plucker {
         let ad = L::select(dneg, -den, den);
         mask = mask & ad.gt(zero) & asum.gt(zero);
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 4. The interval, the one division; u, v are deferred over U + V + W.
-        let mut h = resolve(ray, mask, L::select(dneg, -tn, tn), us, vs, ad);
+        let mut h = resolve(ray, mask, L::select(dneg, -tn, tn), us, vs, ad)?;
         h.w = L::select(h.mask, asum, L::from_f32(1.0));
-        h
+        Some(h)
     }
 }

@@ -37,7 +37,8 @@ pub trait PrecomputedKernel {
     /// The hit of each ray lane on the record in the same lane (as
     /// [`TriangleKernel::intersect`](super::TriangleKernel::intersect): `u`, `v` may be
     /// deferred, see [`LaneHit::normalized`]).
-    fn test<L: Lane>(ray: &RayPacket<L>, pre: &Self::Prim<L>, cull: Cull) -> LaneHit<L>;
+    /// `None` when every lane failed one of its tests (its early exits).
+    fn test<L: Lane>(ray: &RayPacket<L>, pre: &Self::Prim<L>, cull: Cull) -> Option<LaneHit<L>>;
 }
 
 /// Implements [`TriangleKernel`] for a [`PrecomputedKernel`] by precomputing on the fly, with
@@ -52,12 +53,12 @@ macro_rules! precomputed_triangle_kernel {
             fn prepare<L: $crate::lane::Lane>(_: &$crate::ray::RayPacket<L>) -> Self::Rays<L> {}
 
             #[inline(always)]
-            fn intersect<L: $crate::lane::Lane>(
+            fn maybe_intersect<L: $crate::lane::Lane>(
                 ray: &$crate::ray::RayPacket<L>,
                 _: &(),
                 tri: &$crate::triangle::TrianglePacket<L>,
                 cull: $crate::triangle::Cull,
-            ) -> $crate::kernel::LaneHit<L> {
+            ) -> Option<$crate::kernel::LaneHit<L>> {
                 use $crate::triangle::PrecomputedKernel as _;
                 <$k>::test(ray, &<$k>::precompute(tri), cull)
             }

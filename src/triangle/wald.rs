@@ -75,7 +75,7 @@ impl PrecomputedKernel for Wald {
     }
 
     #[inline(always)]
-    fn test<L: Lane>(ray: &RayPacket<L>, r: &WaldRecord<L>, cull: Cull) -> LaneHit<L> {
+    fn test<L: Lane>(ray: &RayPacket<L>, r: &WaldRecord<L>, cull: Cull) -> Option<LaneHit<L>> {
         let (zero, one) = (L::from_f32(0.0), L::from_f32(1.0));
         let (o, d) = (cyclic(r.k, ray.origin), cyclic(r.k, ray.dir));
         // 1. The distance to the plane, f = (n_d − n·o)/(n·d), by a reciprocal (N·d has the
@@ -88,7 +88,7 @@ impl PrecomputedKernel for Wald {
             mask = mask & L::select(r.neg, -den, den).lt(zero);
         }
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 2. The hit point on the projection axes.
         let hu = o.y + f * d.y;
@@ -97,11 +97,11 @@ impl PrecomputedKernel for Wald {
         let u = hu * r.b[0] + hv * r.b[1] + r.b[2];
         mask = mask & u.ge(zero);
         if mask.none() {
-            return LaneHit::miss();
+            return None;
         }
         // 4. v, the weight of C, and the third edge.
         let v = hu * r.c[0] + hv * r.c[1] + r.c[2];
         mask = mask & v.ge(zero) & (u + v).le(one);
-        LaneHit::new(f, u, v, mask)
+        Some(LaneHit::new(f, u, v, mask))
     }
 }

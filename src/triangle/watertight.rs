@@ -128,12 +128,12 @@ impl TriangleKernel for Watertight {
     }
 
     #[inline(always)]
-    fn intersect<L: Lane>(
+    fn maybe_intersect<L: Lane>(
         ray: &RayPacket<L>,
         sh: &Shear<L>,
         tri: &TrianglePacket<L>,
         cull: Cull,
-    ) -> LaneHit<L> {
+    ) -> Option<LaneHit<L>> {
         // 1. Vertices relative to the origin, permuted so that the ray runs along the third axis.
         let a = sh.permute(tri.a) - sh.origin;
         let b = sh.permute(tri.b) - sh.origin;
@@ -151,7 +151,7 @@ fn sheared<L: Lane>(
     b: V3<L>,
     c: V3<L>,
     cull: Cull,
-) -> LaneHit<L> {
+) -> Option<LaneHit<L>> {
     let zero = L::from_f32(0.0);
     // 2. Shear x and y (z is scaled in step 5, only for lanes that pass the edges).
     let (ax, ay) = (a.x - sh.sx * a.z, a.y - sh.sy * a.z);
@@ -187,14 +187,14 @@ fn sheared<L: Lane>(
         front | !(gt[0] | gt[1] | gt[2])
     };
     if mask.none() {
-        return LaneHit::miss();
+        return None;
     }
     let det = u + v + w;
     let back = det.lt(zero);
     let ad = L::select(back, -det, det);
     mask = mask & ad.gt(zero);
     if mask.none() {
-        return LaneHit::miss();
+        return None;
     }
     // 6. Hit distance from the scaled z of the vertices; the interval, then the one division.
     let t = u * (sh.sz * a.z) + v * (sh.sz * b.z) + w * (sh.sz * c.z);
