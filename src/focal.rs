@@ -227,16 +227,14 @@ impl<'c> FocalMesh<'c> {
             self.cache,
             &mut inner,
             |r, e| tf::candidate(r, &tf::Splat(e), cull),
-            |r, i, e, inner| match tf::maybe_hit(r, &tf::Splat(e), cull) {
-                Some(h) => {
-                    let at = At {
-                        set,
-                        index: i as u32,
-                        loc: i as u32,
-                    };
-                    h.mask.any() && inner.offer(&h, at, |_| Hits::miss())
-                }
-                None => false,
+            |r, i, e, inner| {
+                let h = tf::maybe_hit(r, &tf::Splat(e), cull)?;
+                let at = At {
+                    set,
+                    index: i as u32,
+                    loc: i as u32,
+                };
+                h.mask.any().then(|| inner.offer(&h, at, |_| Hits::miss()))
             },
         );
         let w = inner.finish();
@@ -350,17 +348,12 @@ impl Trace for FocalSpheres<'_> {
                     let record = |w: &Winners<L>| {
                         Sphere::records(rays, w, cull, |_| self.spheres.get(i).copied())
                     };
+                    let roots = Focal::maybe_roots(r, &Splat(e))?;
                     if C::EVERY {
-                        let roots = Focal::roots(r, &Splat(e));
-                        each_root(&roots, cull, |h| c.offer(h, at, record))
+                        Some(each_root(&roots, cull, |h| c.offer(h, at, record)))
                     } else {
-                        match Focal::maybe_roots(r, &Splat(e)) {
-                            Some(x) => {
-                                let h = first_root(&x, cull);
-                                h.mask.any() && c.offer(&h, at, record)
-                            }
-                            None => false,
-                        }
+                        let h = first_root(&roots, cull);
+                        h.mask.any().then(|| c.offer(&h, at, record))
                     }
                 },
             );

@@ -241,7 +241,9 @@ impl<L: Lane> Winners<L> {
 #[inline(always)]
 #[must_use]
 pub fn relax<L: Lane>(t: L) -> L {
-    t + (t.abs() + L::from_f32(pow2(-100))) * L::from_f32(pow2(-21))
+    const TINY: f32 = pow2(-100);
+    const STEP: f32 = pow2(-21);
+    t + (t.abs() + L::from_f32(TINY)) * L::from_f32(STEP)
 }
 
 /// Where a set's kernels send their answers (see the [module docs](self)): [`Closest`],
@@ -726,7 +728,9 @@ fn unit<L: Lane>(
 ) -> V3<L> {
     let n2 = v.length_squared();
     let n = v.div_by(n2.sqrt());
-    let odd = mask.and_not(n2.ge(L::from_f32(pow2(-100))) & n2.le(L::from_f32(pow2(100))));
+    const LO: f32 = pow2(-100);
+    const HI: f32 = pow2(100);
+    let odd = mask.and_not(n2.ge(L::from_f32(LO)) & n2.le(L::from_f32(HI)));
     if odd.any() {
         precise_unit(n, odd, exact)
     } else {

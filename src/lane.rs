@@ -157,6 +157,7 @@ impl Mask for bool {
 pub const MAX_LANES: usize = 16;
 
 /// An exact power of two, `2^e` (for `-126 ≤ e ≤ 127`), in constants and kernels alike.
+#[inline(always)]
 pub(crate) const fn pow2(e: i32) -> f32 {
     f32::from_bits(((127 + e) as u32) << 23)
 }
@@ -229,6 +230,15 @@ pub trait Lane:
     fn abs(self) -> Self;
     /// True where the value is neither NaN nor infinite (a bit test; not counted).
     fn is_finite(self) -> Self::Mask;
+    /// The value where it is finite, NaN where it is infinite (or NaN): a kernel's early
+    /// exit `x.finite_or_nan().lt(0)` is then one compare that sends infinite values on, as
+    /// `!(x < 0) | !finite(x)` does (not counted). By default `x + (x − x)` (`x − x` is `+0`
+    /// for every finite `x`, NaN otherwise: the same value, exactly, or NaN), where arithmetic
+    /// is hardware; a bit test where it is software.
+    #[inline(always)]
+    fn finite_or_nan(self) -> Self {
+        self + (self - self)
+    }
     /// Lane `i`.
     fn lane(self, i: usize) -> Self::Scalar;
     /// Builds a lane value from its elements.
@@ -343,6 +353,16 @@ fn arm_vsqrt(x: f32) -> f32 {
     f32::from_bits(bits)
 }
 
+/// True on targets whose `f32` arithmetic is hardware: x86-64, AArch64, Arm with a hard-float
+/// ABI (Cortex-M4F, M7, M33) and RISC-V with the F extension. Elsewhere (Cortex-M0, M3, RISC-V
+/// without F) an add is a library call, and bit tests are cheaper.
+const HARD_FLOAT: bool = cfg!(any(
+    target_arch = "x86_64",
+    target_arch = "aarch64",
+    all(target_arch = "arm", target_abi = "eabihf"),
+    raylane_riscv_f
+));
+
 /// True where `x` is neither NaN nor infinite. Where floating-point arithmetic is hardware
 /// (x86-64, AArch64) as `x − x == 0` (`±0` exactly for every finite `x`, NaN otherwise): one
 /// subtraction and one compare, which LLVM keeps as such (the bit test combines with a
@@ -404,6 +424,16 @@ impl Lane for f32 {
     #[inline(always)]
     fn is_finite(self) -> bool {
         finite_f32(self)
+    }
+    #[inline(always)]
+    fn finite_or_nan(self) -> Self {
+        if HARD_FLOAT {
+            self + (self - self)
+        } else if finite_f32(self) {
+            self
+        } else {
+            f32::NAN
+        }
     }
     #[inline(always)]
     fn lane(self, _i: usize) -> f32 {
@@ -578,6 +608,14 @@ macro_rules! wide_lane {
                 #[cfg(not(any(target_arch = "x86_64", target_arch = "aarch64")))]
                 {
                     $t::is_finite(self)
+                }
+            }
+            #[inline(always)]
+            fn finite_or_nan(self) -> Self {
+                if HARD_FLOAT {
+                    self + (self - self)
+                } else {
+                    Lane::select(Lane::is_finite(self), self, $t::splat(f32::NAN))
                 }
             }
             #[inline(always)]

@@ -259,6 +259,10 @@ impl<L: Lane> Lane for Counted<L> {
         self.0.is_finite()
     }
     #[inline]
+    fn finite_or_nan(self) -> Self {
+        Counted(self.0.finite_or_nan())
+    }
+    #[inline]
     fn lane(self, i: usize) -> Self::Scalar {
         self.0.lane(i)
     }

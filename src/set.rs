@@ -326,9 +326,11 @@ fn candidates<L: Lane, E>(
 /// passes per block of 64 — `candidate` (a kernel's cheap first step, with no calls, so the
 /// rays stay in registers) gives the lanes that may hit each entry, then `test` runs on the
 /// entries some lane may hit. `test` must miss wherever `candidate` has no lane, and
-/// `candidate` must not depend on `t_max`. Before each test the lanes of `keep` get `c`'s
-/// `t_max`, the others an empty interval. One lane takes a single pass (LLVM turns a one-lane
-/// first pass into gathers across entries, 4× slower on x86-64). Returns true when `test` did.
+/// `candidate` must not depend on `t_max`. `test` returns `None` when it offered nothing,
+/// else whether `c` asked to stop. The lanes of `keep` get `c`'s `t_max` (read again after
+/// each offer, the only time it changes), the others an empty interval. One lane takes a
+/// single pass (LLVM turns a one-lane first pass into gathers across entries, 4× slower on
+/// x86-64). Returns true when `c` asked to stop.
 #[inline(always)]
 pub(crate) fn filtered<L: Lane, E, C: Collector<L>>(
     rays: &RayPacket<L>,
@@ -336,14 +338,26 @@ pub(crate) fn filtered<L: Lane, E, C: Collector<L>>(
     entries: &[E],
     c: &mut C,
     mut candidate: impl FnMut(&RayPacket<L>, &E) -> L::Mask,
-    mut test: impl FnMut(&RayPacket<L>, usize, &E, &mut C) -> bool,
+    mut test: impl FnMut(&RayPacket<L>, usize, &E, &mut C) -> Option<bool>,
 ) -> bool {
     let mut r = only(rays, keep);
     let neg = L::from_f32(f32::NEG_INFINITY);
-    if L::LANES == 1 {
-        for (i, e) in entries.iter().enumerate() {
+    r.t_max = L::select(keep, c.t_max(), neg);
+    let mut one = |r: &mut RayPacket<L>, i: usize, e: &E, c: &mut C| match test(r, i, e, c) {
+        None => false,
+        Some(stop) => {
             r.t_max = L::select(keep, c.t_max(), neg);
-            if test(&r, i, e, c) {
+            stop
+        }
+    };
+    if L::LANES == 1 {
+        // The index from the entry's address, not a counter: it is needed only where an
+        // entry is offered, and the miss path then keeps one induction variable.
+        let base = entries.as_ptr() as usize;
+        let size = core::mem::size_of::<E>().max(1);
+        for e in entries {
+            let i = (e as *const E as usize - base) / size;
+            if one(&mut r, i, e, c) {
                 return true;
             }
         }
@@ -354,11 +368,10 @@ pub(crate) fn filtered<L: Lane, E, C: Collector<L>>(
         while bits != 0 {
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            if let Some(e) = block.get(j) {
-                r.t_max = L::select(keep, c.t_max(), neg);
-                if test(&r, b * 64 + j, e, c) {
-                    return true;
-                }
+            if let Some(e) = block.get(j)
+                && one(&mut r, b * 64 + j, e, c)
+            {
+                return true;
             }
         }
     }

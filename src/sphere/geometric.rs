@@ -82,8 +82,8 @@ impl Geometric {
         // 2. Squared distance from the centre to the ray, against r².
         let b2 = p.c2 - v * v;
         // `!(r² < b²)`: a NaN or infinite b² (squares that overflowed) goes on to the range
-        // guard (`is_finite` is a bit test, not counted).
-        let real = !p.r2.lt(b2) | !b2.is_finite();
+        // guard (`finite_or_nan` is not counted).
+        let real = !p.r2.lt(b2.finite_or_nan());
         if real.none() {
             return None;
         }

@@ -416,7 +416,9 @@ pub fn surface<L: Lane>(ray: &RayPacket<L>, sphere: &SpherePacket<L>, t: L) -> S
     let out = point - sphere.center;
     let n2 = out.length_squared();
     let normal = out.div_by(n2.sqrt());
-    let odd = !(n2.ge(L::from_f32(pow2(-100))) & n2.le(L::from_f32(pow2(100))));
+    const LO: f32 = pow2(-100);
+    const HI: f32 = pow2(100);
+    let odd = !(n2.ge(L::from_f32(LO)) & n2.le(L::from_f32(HI)));
     let normal = if guarded::<L>() && odd.any() {
         precise_normals(ray, sphere, t, normal, odd)
     } else {

@@ -78,13 +78,19 @@ fn quadratic<L: Lane, const UNIT: bool>(
     let delta = if UNIT { mu * mu - c } else { mu * mu - a * c };
     // `!(δ < 0)`: a NaN or infinite δ (squares that overflowed) goes on to the range guard,
     // unless the sphere is invalid or padding (NaN radius): such lanes are dropped after the
-    // early exit, which the common miss thus takes on one compare (`is_finite` is a bit
-    // test, not counted).
-    let real = !delta.lt(L::from_f32(0.0)) | !delta.is_finite();
+    // early exit, which the common miss thus takes on one compare (`finite_or_nan` and
+    // `is_finite` are not counted).
+    let real = !delta.finite_or_nan().lt(L::from_f32(0.0));
     if real.none() {
         return None;
     }
-    let real = real & s.radius.is_finite();
+    // Packets drop them here, so that a leaf's padding lanes keep a packet on the miss
+    // path; one ray's NaN roots fail the interval and the guard drops them.
+    let real = if L::LANES > 1 {
+        real & s.radius.is_finite()
+    } else {
+        real
+    };
     if real.none() {
         return None;
     }
