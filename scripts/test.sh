@@ -4,7 +4,7 @@
 #   ./scripts/test.sh
 #
 # 1. Installs what it needs, idempotently: Debian packages (QEMU for Arm and RISC-V, the
-#    AArch64 cross linker, Arm and RISC-V binutils, Embree for the peer benchmarks), rustup
+#    AArch64 cross linker, Arm and RISC-V binutils, Embree for the peer benchmarks, valgrind), rustup
 #    targets, and the MSRV toolchain (Cargo.toml's rust-version) with the minimal profile.
 # 2. Formatting, clippy over the workspace and over the benchmarks with their peers, rustdoc.
 # 3. The library builds for the host, AArch64, thumbv6m (Cortex-M0), thumbv7m (Cortex-M3),
@@ -15,24 +15,27 @@
 #    method at every lane width, and the baseline digests of every method and width.
 # 6. The host suite again built for x86-64-v3 (AVX2, FMA) and for the native CPU (AVX-512
 #    here); their digests must equal the baseline.
-# 7. The whole suite for aarch64-unknown-linux-gnu under qemu-aarch64 (wide's NEON path), and
+# 7. Instructions per ray–primitive test of every kernel through the library's query, on
+#    x86-64-v3 (callgrind) and the Cortex-M4F (QEMU plugin), against their pins in
+#    benches/counts/ (scripts/count-check.sh): no count may rise more than 3 %.
+# 8. The whole suite for aarch64-unknown-linux-gnu under qemu-aarch64 (wide's NEON path), and
 #    its digests.
-# 8. The firmware under targets/ on six QEMU boards: micro:bit (Cortex-M0; every vector at
+# 9. The firmware under targets/ on six QEMU boards: micro:bit (Cortex-M0; every vector at
 #    lane width 1, the flash holding no more), mps2-an385 (Cortex-M3, soft float), mps2-an386
 #    (Cortex-M4F), mps2-an505 (Cortex-M33), and RISC-V 32 `virt` soft float (rv32imac) and
 #    hard float (rv32imafc): every vector through every method and width, digests equal to
 #    x86-64's, and the op-count report measured on the target equal to the host's.
-# 9. Firmware checks: the kernels link with a panic handler that does not exist (no panic
+# 10. Firmware checks: the kernels link with a panic handler that does not exist (no panic
 #    path) on every target; square roots are `vsqrt.f32` (M4F, M33) and `fsqrt.s`
 #    (rv32imafc) with no software sqrtf; code size per target (scalar kernels, and with
 #    4-lane packets).
-# 10. The demo's scene 4 rendered by the firmware on five boards (scalar lane, written to the
+# 11. The demo's scene 4 rendered by the firmware on five boards (scalar lane, written to the
 #    host through semihosting) equals the host's render at every packet width, byte for byte;
 #    the vendored bunny baked on the host (targets/build.rs) and traced from flash on all six
 #    boards, the Cortex-M0 included, equals the host's render at every width the board holds,
 #    with a table of each board's flash, RAM (stack painting) and largest mesh that fits.
-# 11. The README's firmware crate (examples/firmware) built and run on the Cortex-M4F and M0.
-# 12. A summary: every configuration with its digest, code size and run time.
+# 12. The README's firmware crate (examples/firmware) built and run on the Cortex-M4F and M0.
+# 13. A summary: every configuration with its digest, code size and run time.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -50,6 +53,7 @@ command -v aarch64-linux-gnu-gcc >/dev/null || need+=(gcc-aarch64-linux-gnu)
 command -v arm-none-eabi-objdump >/dev/null || need+=(binutils-arm-none-eabi)
 command -v riscv64-unknown-elf-objdump >/dev/null || need+=(binutils-riscv64-unknown-elf)
 [ -e /usr/include/embree3/rtcore.h ] || need+=(libembree-dev)
+command -v valgrind >/dev/null || need+=(valgrind)
 if [ ${#need[@]} -gt 0 ]; then
   sudo=""; [ "$(id -u)" -eq 0 ] || sudo="sudo"
   echo "installing: ${need[*]}"
@@ -145,6 +149,11 @@ for cpu in x86-64-v3 native; do
   grep '^digest' "target/digests/$cpu.log" > "target/digests/$cpu.txt"
   same "$cpu" "target/digests/$cpu.txt"
 done
+
+step "instructions per test, recounted against their pins (benches/counts/)"
+# callgrind on x86-64-v3 and QEMU's TCG plugin on the Cortex-M4F, both exact and repeatable:
+# a count more than 3 % above its pin fails (a deliberate change re-pins: count-check.sh --pin).
+./scripts/count-check.sh
 
 step "AArch64 (NEON) test suite under qemu-aarch64"
 cargo test --quiet --release --target aarch64-unknown-linux-gnu

@@ -10,7 +10,12 @@
 //! count table FILE TITLE print the Markdown table from `cfg ... INSTRUCTIONS` lines
 //! count ops              the op counts per test of every kernel on both ray sets
 //! count digest           a digest of the scene's bits (the firmware prints the same)
+//! count check PIN NEW    every count of the table NEW against the pinned table PIN: fails
+//!                        (exit 1) when one rose more than 3 % above its pin, or is missing
 //! ```
+//!
+//! The pins are `benches/counts/*.md` (the tables as `table` prints them); `scripts/test.sh`
+//! recounts and checks them. A deliberate change updates the pin in the same commit.
 //!
 //! The scene: 64 spheres, triangles and planes, a 32 × 32 camera ([`Frame::with_image`]);
 //! `coherent` is every primary ray, `miss` the primary rays whose lines clearly miss every
@@ -222,6 +227,86 @@ fn print_ops() {
     }
 }
 
+/// A count may rise this much above its pin (deterministic counts; the margin covers
+/// deliberate trade-offs too small to re-pin for).
+const SLACK: f64 = 1.03;
+
+/// The counts of a table `table` printed: (kernel, rays, shape, width) → instructions per test.
+fn read_table(file: &str) -> BTreeMap<(String, String, String, String), f64> {
+    let text = std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{file}: {e}"));
+    let mut widths: Vec<Option<String>> = Vec::new();
+    let mut out = BTreeMap::new();
+    for line in text.lines().filter(|l| l.starts_with('|')) {
+        let cells: Vec<&str> = line.trim_matches('|').split('|').map(str::trim).collect();
+        if cells.first() == Some(&"kernel") {
+            // The header: which columns are lane widths (`x8`, not `x8 ÷ minimum`).
+            widths = cells
+                .iter()
+                .map(|c| {
+                    (c.starts_with('x') && c[1..].chars().all(|d| d.is_ascii_digit()))
+                        .then(|| c.to_string())
+                })
+                .collect();
+            continue;
+        }
+        if cells.len() != widths.len() || cells.iter().all(|c| c.starts_with("--")) {
+            continue;
+        }
+        for (cell, w) in cells.iter().zip(&widths) {
+            let (Some(w), Some(n)) = (w, cell.split_whitespace().next()) else {
+                continue;
+            };
+            if let Ok(n) = n.parse::<f64>() {
+                let key = (
+                    cells[0].to_string(),
+                    cells[1].to_string(),
+                    cells[2].to_string(),
+                    w.clone(),
+                );
+                out.insert(key, n);
+            }
+        }
+    }
+    out
+}
+
+/// Checks every pinned count of `pin` against `new`; prints each failure and a summary.
+fn check(pin: &str, new: &str) -> bool {
+    let (pins, counts) = (read_table(pin), read_table(new));
+    let mut bad = 0;
+    let (mut lower, mut same) = (0, 0);
+    for (key, &p) in &pins {
+        let (k, rays, shape, w) = key;
+        match counts.get(key) {
+            None => {
+                println!("MISSING  {k} {rays} {shape} {w}: pinned {p:.2}, not counted");
+                bad += 1;
+            }
+            Some(&n) if n > p * SLACK => {
+                println!(
+                    "ROSE     {k} {rays} {shape} {w}: {n:.2} against the pin {p:.2} (+{:.1} %)",
+                    (n / p - 1.0) * 100.0
+                );
+                bad += 1;
+            }
+            Some(&n) if n < p / SLACK => {
+                println!(
+                    "fell     {k} {rays} {shape} {w}: {n:.2} against the pin {p:.2} ({:.1} %): re-pin",
+                    (n / p - 1.0) * 100.0
+                );
+                lower += 1;
+            }
+            Some(_) => same += 1,
+        }
+    }
+    println!(
+        "{pin}: {} counts pinned; {same} within 3 % of their pins, {lower} more than 3 % \
+         below, {bad} above or missing",
+        pins.len()
+    );
+    bad == 0
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     match args.first().map(String::as_str) {
@@ -231,13 +316,24 @@ fn main() {
             args.get(2).map_or("Instructions per test", String::as_str),
         ),
         Some("ops") => print_ops(),
+        Some("check") => {
+            let (Some(pin), Some(new)) = (args.get(1), args.get(2)) else {
+                eprintln!("usage: count check PIN NEW");
+                std::process::exit(2);
+            };
+            if !check(pin, new) {
+                std::process::exit(1);
+            }
+        }
         Some("digest") => {
             for f in frames() {
                 println!("scene {} {:016x}", f.kind.name(), raylane_bench::digest(&f));
             }
         }
         _ => {
-            eprintln!("usage: count measure | table FILE TITLE | ops | digest");
+            eprintln!(
+                "usage: count measure [KERNEL] | table FILE TITLE | ops | digest | check PIN NEW"
+            );
             std::process::exit(2);
         }
     }
