@@ -236,6 +236,7 @@ pub trait Lane:
     /// for every finite `x`, NaN otherwise: the same value, exactly, or NaN), where arithmetic
     /// is hardware; a bit test where it is software.
     #[inline(always)]
+    #[allow(clippy::eq_op)] // `x − x`: +0 for every finite x, NaN otherwise
     fn finite_or_nan(self) -> Self {
         self + (self - self)
     }
@@ -370,6 +371,7 @@ const HARD_FLOAT: bool = cfg!(any(
 /// integer instructions). Elsewhere (Cortex-M, RISC-V, possibly without an FPU) the bit
 /// test. The same answer for every input; not counted as floating-point work.
 #[inline(always)]
+#[allow(clippy::eq_op)] // `x − x`: +0 for every finite x, NaN otherwise
 fn finite_f32(x: f32) -> bool {
     #[cfg(any(target_arch = "x86_64", target_arch = "aarch64"))]
     {
@@ -426,6 +428,7 @@ impl Lane for f32 {
         finite_f32(self)
     }
     #[inline(always)]
+    #[allow(clippy::eq_op)] // `x − x`: +0 for every finite x, NaN otherwise
     fn finite_or_nan(self) -> Self {
         if HARD_FLOAT {
             self + (self - self)
@@ -611,6 +614,7 @@ macro_rules! wide_lane {
                 }
             }
             #[inline(always)]
+            #[allow(clippy::eq_op)] // `x − x`: +0 for every finite x, NaN otherwise
             fn finite_or_nan(self) -> Self {
                 if HARD_FLOAT {
                     self + (self - self)
