@@ -9,10 +9,14 @@
 //!   test some of them make before dividing (`num < t_max·den`, rounded) can never drop such a
 //!   hit, and the collector checks the rounded `t < t_max` itself. `closest`, `any` and `all`
 //!   therefore agree for every `t_max`, finite or not.
-//! * **The tie rule.** The closest hit is the smallest `(t, set, index)`: the smallest rounded
-//!   `t`, ties to the lower set (the position in a tuple, the instance of a scene), then the
-//!   lower primitive index. It does not depend on the order the primitives are visited in, so
-//!   brute force, a BVH and every packet width return the same hit, bit for bit.
+//! * **The tie rule.** The closest hit is the smallest `(t, set, index, loc)`: the smallest
+//!   rounded `t`, ties to the lower set (the position in a tuple, the instance of a scene),
+//!   then the lower primitive index, then the lower `loc` (where the set keeps the primitive,
+//!   [`At::loc`]: unique within a set). `loc` decides only between primitives that share an
+//!   index, which a set can hold only where nothing checks its indices (a baked tree's ids, the
+//!   leaves given to `Bvh::from_parts`); with unique indices the rule is `(t, set, index)`.
+//!   It does not depend on the order the primitives are visited in, so brute force, a BVH
+//!   and every packet width return the same hit, bit for bit.
 //! * **Shrinking.** After a hit at `t`, kernels are asked with `t_max` relaxed from `t`
 //!   (`t + (|t| + 2^-100)·2^-21`, strictly above `t` even at `t = 0`), so ties at `t` still
 //!   reach the collector and everything farther is cut.
@@ -167,14 +171,16 @@ impl<L: Lane> Hits<L> {
 
 /// Where a candidate comes from: the set (tuple position or instance), the primitive's index
 /// in it, and where the set keeps the primitive (`loc`: the index for a flat set, the leaf
-/// and lane in a BVH), so that records can be made for the winner alone.
+/// and lane in a BVH, the position in a baked tree), so that records can be made for the
+/// winner alone. `loc` is unique within a set: the tie rule's last key (see the
+/// [module docs](self)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct At {
     /// The set.
     pub set: u32,
     /// The primitive's index in the set.
     pub index: u32,
-    /// Where the set keeps it.
+    /// Where the set keeps it (unique within the set).
     pub loc: u32,
 }
 
@@ -271,7 +277,7 @@ pub trait Collector<L: Lane> {
     ) -> bool;
 }
 
-/// The closest hit per lane: the smallest `(t, set, index)` with `t` inside the interval.
+/// The closest hit per lane: the smallest `(t, set, index, loc)` with `t` inside the interval.
 #[derive(Clone, Copy, Debug)]
 pub struct Closest<L: Lane> {
     t: L,
@@ -366,7 +372,7 @@ impl<L: Lane> Closest<L> {
         self.consider(&h, at);
     }
 
-    /// The candidates of `h` from `at`: taken where they come first by `(t, set, index)`.
+    /// The candidates of `h` from `at`: taken where they come first by `(t, set, index, loc)`.
     #[inline(always)]
     fn consider(&mut self, h: &LaneHit<L>, at: At) {
         // The interval (the kernel checked t_min), then the tie rule.
@@ -390,7 +396,8 @@ impl<L: Lane> Closest<L> {
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;
             let get = |x: &L::Indices| x.as_ref().get(j).copied().unwrap_or(u32::MAX);
-            if (at.set, at.index) < (get(&self.set), get(&self.index)) {
+            // `loc` last: it decides only between primitives that share an index.
+            if (at.set, at.index, at.loc) < (get(&self.set), get(&self.index), get(&self.loc)) {
                 take = take.with_lane(j, true);
             }
         }

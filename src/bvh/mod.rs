@@ -90,9 +90,11 @@
 //! ties to the lowest primitive index, with the same `t`, `u`, `v`, index bits (and so the same
 //! point, normal and face), whatever order the tree is visited in. Two things make it so:
 //!
-//! 1. **One tie rule.** A candidate wins on `(t, set, index)`, and kernels are asked with
-//!    `t_max` relaxed after each hit, by the collector that brute force uses too
-//!    ([`crate::hit`]), so a kernel's pre-division test never drops a would-be winner.
+//! 1. **One tie rule.** A candidate wins on `(t, set, index, loc)` (`loc`, the leaf and lane,
+//!    decides only between lanes that share an index, as [`Bvh::from_parts`] allows), and
+//!    kernels are asked with `t_max` relaxed after each hit, by the collector that brute force
+//!    uses too ([`crate::hit`]), so a kernel's pre-division test never drops a would-be
+//!    winner.
 //! 2. **Conservative boxes** (in the spirit of Ize, "Robust BVH Ray Traversal", JCGT 2013).
 //!    Each box is widened by `m = 2^-17·(R + |o|∞)`, with `R` the largest coordinate in the
 //!    tree and `o` the ray's origin: the Watertight kernel's edge tests and `t` are exact up to

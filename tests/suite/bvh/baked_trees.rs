@@ -1,18 +1,21 @@
 //! Trees baked on a host (`bvh::bake`): the baked tree answers as the mesh it was baked from,
 //! bit for bit, at every width, with every collector; opening checks every byte (bad headers,
 //! every error of its list), and no mutation of a real baked tree panics, loops, reads out of
-//! bounds or gives a hit outside the baked triangles.
+//! bounds or gives a hit other than brute force's over the baked triangles, at any width.
+//! Issue 31's gaps each have a hand-made image and format-guided edits in the mutation fuzz.
 
 use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bvh::bake::{Baked, HEADER, OpenError, bake};
+use raylane::bvh::{LEAF, Node4};
 use raylane::mesh::Mesh;
 use raylane::triangle::{Moller, Triangle};
-use raylane::{Cull, Query, Ray, RayPacket};
-use wide::f32x8;
+use raylane::{Cull, Query, Ray};
 
-use crate::bvh::equals_brute_force::{check, grazing_grid, grazing_packets, rays, soup};
+use crate::bvh::equals_brute_force::{
+    brute_with_ids, check, every_width, grazing_grid, grazing_packets, rays, soup,
+};
 use crate::sets::query_records_every_width::bits;
 
 /// The bytes at a 16-byte boundary (as `include_baked!` links them).
@@ -159,30 +162,151 @@ fn opening_refuses_bad_headers() {
     assert_eq!(open(&a, len), None);
 }
 
-/// A baked tree's answers, if it opens: every hit is the brute-force hit over its own
-/// (validated) triangles, and nothing panics.
-fn answers_if_open(bytes: &[u8], rays: &[Ray]) -> Result<usize, OpenError> {
-    let tree = Baked::open(bytes)?;
-    // Brute force over the baked triangles themselves, ties to the lower id.
+/// The closest hit over a baked tree's own triangles by brute force, ids as baked (the tie
+/// rule's `(t, id, position)`).
+fn brute(tree: &Baked, r: &Ray) -> Option<[u32; 12]> {
     let (ids, flat): (Vec<u32>, Vec<Triangle>) =
         (0..tree.len()).filter_map(|i| tree.get(i)).unzip();
-    let mut hits = 0;
-    for r in rays {
-        let got = tree.closest(r);
-        let mut best: Option<(f32, u32)> = None;
-        flat[..].all(r, |h| {
-            let key = (h.t, ids[h.index as usize]);
-            if best.is_none_or(|b| key < b) {
-                best = Some(key);
-            }
-        });
-        assert_eq!(got.map(|h| (h.t, h.index)), best);
-        let p = tree.closest(&RayPacket::<f32x8>::splat(r));
-        assert_eq!(bits(p.lane(3)), bits(got));
-        assert_eq!(tree.any(r), got.is_some());
-        hits += got.is_some() as usize;
+    brute_with_ids(&flat, &ids, r)
+}
+
+/// A baked tree's answers, if it opens: every hit, one ray and packets of 1, 4, 8 and 16
+/// lanes alike, is the brute-force hit over its own (validated) triangles, bit for bit, and
+/// nothing panics.
+fn answers_if_open(bytes: &[u8], rays: &[Ray]) -> Result<usize, OpenError> {
+    let tree = Baked::open(bytes)?;
+    let want: Vec<_> = rays.iter().map(|r| brute(&tree, r)).collect();
+    every_width(&tree, rays, &want);
+    Ok(want.iter().filter(|w| w.is_some()).count())
+}
+
+/// Header word `k` (bytes `4k..4k + 4`).
+fn word(b: &[u8], k: usize) -> u32 {
+    u32::from_le_bytes(b[4 * k..4 * k + 4].try_into().unwrap())
+}
+
+fn set_word(b: &mut [u8], k: usize, x: u32) {
+    b[4 * k..4 * k + 4].copy_from_slice(&x.to_le_bytes());
+}
+
+/// A tree with 16-bit indices written by hand, field by field as the module docs' table
+/// lays them out (`bake` writes the same layout).
+fn image(
+    nodes: &[Node4],
+    tris: &[[u16; 3]],
+    ids: &[u16],
+    verts: &[[f32; 3]],
+    depth: u32,
+) -> Vec<u8> {
+    let mut b = vec![0u8; HEADER];
+    let align = |b: &mut Vec<u8>| b.resize(b.len().next_multiple_of(4), 0);
+    let off_nodes = b.len();
+    for n in nodes {
+        n.origin.iter().for_each(|x| b.extend(x.to_le_bytes()));
+        b.extend(n.exp.map(|e| e as u8));
+        b.push(n.pad);
+        n.lo.iter().chain(&n.hi).for_each(|q| b.extend(q));
+        n.child.iter().for_each(|c| b.extend(c.to_le_bytes()));
     }
-    Ok(hits)
+    let off_tris = b.len();
+    tris.iter()
+        .flatten()
+        .for_each(|i| b.extend(i.to_le_bytes()));
+    align(&mut b);
+    let off_ids = b.len();
+    ids.iter().for_each(|i| b.extend(i.to_le_bytes()));
+    align(&mut b);
+    let off_verts = b.len();
+    verts
+        .iter()
+        .flatten()
+        .for_each(|x| b.extend(x.to_le_bytes()));
+    b[..8].copy_from_slice(b"RLBV\x01\x00\x00\x00");
+    let words = [
+        nodes.len(),
+        tris.len(),
+        verts.len(),
+        depth as usize,
+        off_nodes,
+        off_tris,
+        off_ids,
+        off_verts,
+        b.len(),
+    ];
+    for (k, &w) in words.iter().enumerate() {
+        set_word(&mut b, 2 + k, w as u32);
+    }
+    b
+}
+
+/// Two triangles in two leaves of one root, meeting along the edge `x = 0` of the plane
+/// `z = 0`, each rising to `z = 1/2` at its far corner: A, baked triangle 0, on the left; B,
+/// baked triangle 1, on the right. A ray from the left reaches A's box first, one from the
+/// right B's; both hit the shared edge at `t = 1` in both triangles (with other `u`, `v` and
+/// normals). The ids are the caller's.
+fn two_leaves(ids: [u16; 2], depth: u32) -> Vec<u8> {
+    let verts = [
+        [-1.0, 0.0, 0.5],
+        [0.0, 0.0, 0.0],
+        [0.0, 1.0, 0.0],
+        [1.0, 0.0, 0.5],
+    ];
+    // The root's box is [-1, 1] × [0, 1] × [0, 1/2]: quanta 2^-6, 2^-7, 2^-8.
+    let mut root = Node4 {
+        origin: [-1.0, 0.0, 0.0],
+        exp: [-6, -7, -8],
+        ..Node4::EMPTY
+    };
+    for (k, (x0, x1)) in [(0, 64), (64, 128)].into_iter().enumerate() {
+        root.lo[0][k] = x0;
+        root.hi[0][k] = x1;
+        (root.lo[1][k], root.hi[1][k]) = (0, 128);
+        (root.lo[2][k], root.hi[2][k]) = (0, 128);
+        root.child[k] = LEAF | (k as u32) << 2; // one triangle, the k-th
+    }
+    image(&[root], &[[0, 1, 2], [1, 3, 2]], &ids, &verts, depth)
+}
+
+/// A ray from the left and one from the right at the point `(0, 1/2, 0)` of `two_leaves`' shared
+/// edge, in packets led by one of them (a packet visits leaves in its first lane's order).
+pub(crate) fn from_both_sides() -> Vec<Ray> {
+    let left = Ray::new(Vec3::new(-0.5, 0.5, 1.0), Vec3::new(0.5, 0.0, -1.0));
+    let right = Ray::new(Vec3::new(0.5, 0.5, 1.0), Vec3::new(-0.5, 0.0, -1.0));
+    let mut rays = vec![left];
+    rays.extend([right; 15]);
+    rays.push(right);
+    rays.extend([left; 15]);
+    rays
+}
+
+/// Issue 31, gap 3: two triangles with one id tied at the same `t` (a shared edge). Rays from
+/// either side visit them in opposite orders, and a packet's lane follows its first lane's
+/// order; the tie rule's last key, the position in the tree, picks the same one (the earlier)
+/// for every ray at every width: the same record, bit for bit. Fails with the rule
+/// `(t, set, index)`: the ray from the right alone returns B.
+#[test]
+fn duplicated_ids_give_one_answer_at_every_width() {
+    for ids in [[0, 0], [7, 7], [0, 1], [1, 0]] {
+        let bytes = two_leaves(ids, 1);
+        let a = aligned(&bytes);
+        let tree = Baked::open(&a.0[..bytes.len()]).unwrap();
+        let rays = from_both_sides();
+        let want: Vec<_> = rays.iter().map(|r| brute(&tree, r)).collect();
+        for w in &want {
+            let w = w.expect("both rays hit the edge");
+            assert_eq!(f32::from_bits(w[0]), 1.0);
+            // The earlier triangle (A) when the ids tie, else the lower id's.
+            let a_wins = ids[0] <= ids[1];
+            assert_eq!(w[8], u32::from(if a_wins { ids[0] } else { ids[1] }));
+        }
+        // Both triangles are hit there, with other barycentrics (so a wrong winner shows).
+        let (_, ta) = tree.get(0).unwrap();
+        let (_, tb) = tree.get(1).unwrap();
+        let (ha, hb) = ([ta][..].closest(&rays[0]), [tb][..].closest(&rays[0]));
+        assert_eq!((ha.unwrap().t, hb.unwrap().t), (1.0, 1.0));
+        assert_ne!(bits(ha).unwrap()[10..], bits(hb).unwrap()[10..]);
+        every_width(&tree, &rays, &want);
+    }
 }
 
 #[test]
@@ -233,6 +357,39 @@ fn no_mutation_of_a_baked_tree_panics_or_answers_wrongly() {
         "3000 mutated trees: {opened} opened (answers checked), {refused} refused: {reasons:?}"
     );
     assert!(refused > 1000 && opened > 100, "{opened} {refused}");
+    // Edits guided by the format table (issue 31), each with the outcome it must have.
+    assert_eq!(bytes[6], 0, "16-bit indices and ids");
+    let n = word(&bytes, 3) as usize;
+    let ids_at = word(&bytes, 8) as usize;
+    let id = |b: &[u8], t: usize| [b[ids_at + 2 * t], b[ids_at + 2 * t + 1]];
+    for case in 0..300 {
+        let mut b = bytes.clone();
+        // Ids duplicated: every id one triangle's, a run of ids its first's, or ids their
+        // neighbours'. The tree opens and answers as brute force at every width.
+        let mode = case % 3;
+        let (from, to) = match mode {
+            0 => (0, n),
+            1 => {
+                let s = rng.random_range(0..n - 1);
+                (s, (s + rng.random_range(2..64)).min(n))
+            }
+            _ => (rng.random_range(0..n / 2), n),
+        };
+        let one = id(&b, rng.random_range(0..n));
+        for t in from..to {
+            let x = match mode {
+                0 => one,
+                1 => id(&b, from),
+                _ if rng.random_bool(0.5) => id(&b, (t + 1) % n),
+                _ => id(&b, t),
+            };
+            b[ids_at + 2 * t..ids_at + 2 * t + 2].copy_from_slice(&x);
+        }
+        let want = Ok(());
+        let a = aligned(&b);
+        let got = answers_if_open(&a.0[..b.len()], &rs).map(|_| ());
+        assert_eq!(got, want, "case {case}");
+    }
     // The unmutated tree answers as the mesh.
     let a = aligned(&bytes);
     let tree = Baked::open(&a.0[..bytes.len()]).unwrap();

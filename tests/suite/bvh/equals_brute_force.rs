@@ -84,6 +84,58 @@ fn packets_of<L: Lane<Scalar = f32>>(rays: &[Ray], tree: &impl Query, flat: &imp
     }
 }
 
+/// The closest hit over `flat` by brute force under the tie rule `(t, id, position)`, with
+/// `ids[i]` the id of `flat[i]` (ids need not be unique): the smallest `t`, ties to the lower
+/// id, then to the earlier triangle; that triangle's record, with its id.
+pub(crate) fn brute_with_ids(flat: &[Triangle], ids: &[u32], r: &Ray) -> Option<[u32; 12]> {
+    let mut best: Option<(f32, u32, u32)> = None;
+    flat.all(r, |h| {
+        let key = (h.t, ids[h.index as usize], h.index);
+        if best.is_none_or(|b| key < b) {
+            best = Some(key);
+        }
+    });
+    best.map(|(_, id, at)| {
+        let at = at as usize;
+        let mut h = flat[at..=at].closest(r).expect("the winner hits alone");
+        h.index = id;
+        bits(Some(h)).unwrap()
+    })
+}
+
+/// `tree`'s closest hits of `rays`, one ray at a time and in packets of 1, 4, 8 and 16 of them
+/// (so that a lane may follow another lane's visiting order), are `want`'s, bit for bit; `any`
+/// agrees.
+pub(crate) fn every_width(tree: &impl Query, rays: &[Ray], want: &[Option<[u32; 12]>]) {
+    for (i, r) in rays.iter().enumerate() {
+        assert_eq!(bits(tree.closest(r)), want[i], "one ray, ray {i}: {r:?}");
+        assert_eq!(tree.any(r), want[i].is_some(), "any, ray {i}: {r:?}");
+    }
+    packets_want::<f32>(tree, rays, want);
+    packets_want::<f32x4>(tree, rays, want);
+    packets_want::<f32x8>(tree, rays, want);
+    packets_want::<f32x16>(tree, rays, want);
+}
+
+fn packets_want<L: Lane<Scalar = f32>>(
+    tree: &impl Query,
+    rays: &[Ray],
+    want: &[Option<[u32; 12]>],
+) {
+    for (c, chunk) in rays.chunks(L::LANES).enumerate() {
+        let got = tree.closest(&RayPacket::<L>::from_rays(chunk));
+        for (i, r) in chunk.iter().enumerate() {
+            let k = c * L::LANES + i;
+            assert_eq!(
+                bits(got.lane(i)),
+                want[k],
+                "{} lanes, ray {k}: {r:?}",
+                L::LANES
+            );
+        }
+    }
+}
+
 /// The tree against the flat set on every ray: one-ray `closest`/`any` and packets of 1, 4,
 /// 8, 16 rays, bit for bit. Returns the number of hits.
 pub(crate) fn check(tree: &impl Query, flat: &impl Query, rays: &[Ray]) -> usize {
