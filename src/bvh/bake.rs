@@ -44,16 +44,38 @@
 //! | ids | the triangle's index in the mesh that was baked (`u16` or `u32`), the index hits report |
 //! | vertices | `f32` x, y, z |
 //!
-//! **What opening checks** ([`Baked::open`], one depth-first pass, its stack the traversal's):
-//! the header (magic, version, flags, sizes and offsets in range, aligned, the sections inside
-//! the bytes); every node reached exactly once from the root, in preorder (so the tree is a
-//! tree: no node reached twice, none left out, every child index pointing forward); the depth
-//! within [`MAX_DEPTH4`]; unused slots canonical; every leaf's triangles the next ones in order
-//! (none skipped or shared), 1 to 4 per leaf; vertex indices in range; every vertex finite;
-//! every node's origin finite and exponents in range; and every triangle inside the decoded box
-//! of every node above it, so that the traversal's answers are brute force's over the baked
-//! triangles. Any other input is an error value ([`OpenError`]), never a panic, an
-//! out-of-bounds read or a loop.
+//! **What opening checks** ([`Baked::open`]: the header, the vertices, then one depth-first
+//! pass over the tree, its stack the traversal's), in this order, each with its [`OpenError`]:
+//!
+//! 1. The host is little-endian ([`BigEndian`](OpenError::BigEndian)).
+//! 2. The bytes hold the header ([`Truncated`](OpenError::Truncated)) and start at a 4-byte
+//!    boundary ([`Misaligned`](OpenError::Misaligned)).
+//! 3. The magic ([`Magic`](OpenError::Magic)) and the version
+//!    ([`Version`](OpenError::Version)).
+//! 4. No unknown flag, bytes 44–63 zero ([`Header`](OpenError::Header)).
+//! 5. The total length is the number of bytes ([`Truncated`](OpenError::Truncated)).
+//! 6. At least one node ([`Order(0)`](OpenError::Order)).
+//! 7. The depth field from 1 to [`MAX_DEPTH4`] ([`TooDeep`](OpenError::TooDeep)).
+//! 8. Each section at a 4-byte boundary after the header ([`Header`](OpenError::Header)) and
+//!    inside the bytes ([`Truncated`](OpenError::Truncated)).
+//! 9. Every vertex finite, whether a triangle uses it or not ([`Vertex`](OpenError::Vertex)):
+//!    a NaN or an infinity anywhere is a sign of corruption.
+//! 10. From the root, depth first: each node the next one in preorder, so every node is reached
+//!     exactly once (a tree: none reached twice, none left out, every child after its parent;
+//!     [`Order`](OpenError::Order)); its pad zero, its origin finite, its exponents in
+//!     −126…127, its unused slots canonical (`lo` 255, `hi` 0; [`Node`](OpenError::Node)); no
+//!     inner child below depth [`MAX_DEPTH4`] ([`TooDeep`](OpenError::TooDeep)); each leaf 1 to
+//!     4 triangles, the next ones in order, none skipped or shared
+//!     ([`Leaf`](OpenError::Leaf)); each triangle's vertex indices in range
+//!     ([`Triangle`](OpenError::Triangle)); and each of its vertices inside the decoded box of
+//!     every node above it ([`Outside`](OpenError::Outside)), so that the traversal's answers
+//!     are brute force's over the baked triangles.
+//! 11. No node ([`Order`](OpenError::Order)) and no triangle ([`Leaf`](OpenError::Leaf)) left
+//!     over.
+//!
+//! Any other input is an error value, never a panic, an out-of-bounds read or a loop. The ids
+//! are not checked: any value is an answer, and two triangles with one id tied at one `t` go
+//! to the earlier one in leaf order at every width (the tie rule's last key, [`crate::hit`]).
 
 use glam::Vec3;
 use wide::f32x4;
@@ -103,8 +125,10 @@ pub enum OpenError {
     TooDeep,
     /// A leaf of node `.0` holds no triangle, more than 4, or not the next ones.
     Leaf(u32),
-    /// Triangle `.0` has a vertex index out of range or a non-finite vertex.
+    /// Triangle `.0` has a vertex index out of range.
     Triangle(u32),
+    /// Vertex `.0` is not finite (NaN or infinite), whether a triangle uses it or not.
+    Vertex(u32),
     /// Triangle `.0` lies outside the box of a node above it.
     Outside(u32),
 }
@@ -216,6 +240,12 @@ impl<'a> Baked<'a> {
             )
         };
         let vertices: &[[f32; 3]] = section(bytes, word(9), n_verts)?;
+        if let Some(v) = vertices
+            .iter()
+            .position(|p| !p.iter().all(|x| x.is_finite()))
+        {
+            return Err(OpenError::Vertex(v as u32));
+        }
         let mut tree = Baked {
             nodes,
             tris,
@@ -343,7 +373,6 @@ impl<'a> Baked<'a> {
         stack[0] = (0, 1, [f32::NEG_INFINITY; 3], [f32::INFINITY; 3]);
         let mut sp = 1usize;
         let (mut next_node, mut next_tri) = (0u32, 0usize);
-        let n_verts = self.vertices.len();
         while sp > 0 {
             sp -= 1;
             let (i, d, lo, hi) = stack[sp];
@@ -387,12 +416,9 @@ impl<'a> Baked<'a> {
                 }
                 for t in first..first + count {
                     let corners = self.corners(t).ok_or(OpenError::Leaf(i))?;
-                    let bad = OpenError::Triangle(t as u32);
                     for v in corners {
-                        let p = self.vertices.get(v).ok_or(bad)?;
-                        if v >= n_verts || !p.iter().all(|x| x.is_finite()) {
-                            return Err(bad);
-                        }
+                        // In range (every vertex is finite: `open` checked them all).
+                        let p = self.vertices.get(v).ok_or(OpenError::Triangle(t as u32))?;
                         if (0..3).any(|a| !(p[a] >= clo[a] && p[a] <= chi[a])) {
                             return Err(OpenError::Outside(t as u32));
                         }

@@ -189,6 +189,11 @@ fn set_word(b: &mut [u8], k: usize, x: u32) {
     b[4 * k..4 * k + 4].copy_from_slice(&x.to_le_bytes());
 }
 
+/// The total length field made the number of bytes.
+fn set_len(b: &mut [u8]) {
+    set_word(b, 10, b.len() as u32);
+}
+
 /// A tree with 16-bit indices written by hand, field by field as the module docs' table
 /// lays them out (`bake` writes the same layout).
 fn image(
@@ -279,6 +284,47 @@ pub(crate) fn from_both_sides() -> Vec<Ray> {
     rays
 }
 
+/// Issue 31, gap 1: a one-triangle image with a vertex appended that no triangle uses (the
+/// count and the length raised to match) opens when the vertex is finite and is refused when
+/// a coordinate is NaN or infinite, as is a used vertex made NaN. Fails when only the vertices
+/// a triangle uses are checked: the image with the unused NaN vertex opens.
+#[test]
+fn every_vertex_is_checked_used_or_not() {
+    let pos = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let mesh = Mesh::new(&pos, &[[0, 1, 2]]);
+    let bytes = bake(&mesh).unwrap();
+    let ray = Ray::new(Vec3::new(0.25, 0.25, 1.0), Vec3::NEG_Z);
+    let cases = [
+        (f32::NAN, Err(OpenError::Vertex(3))),
+        (f32::INFINITY, Err(OpenError::Vertex(3))),
+        (f32::NEG_INFINITY, Err(OpenError::Vertex(3))),
+        (-0.0, Ok(())),
+        (1e30, Ok(())),
+    ];
+    for (x, want) in cases {
+        for axis in 0..3 {
+            let mut b = bytes.clone();
+            let mut v = [0.5f32; 3];
+            v[axis] = x;
+            b.extend(v.iter().flat_map(|x| x.to_le_bytes()));
+            set_word(&mut b, 4, 4);
+            set_len(&mut b);
+            let a = aligned(&b);
+            let got = Baked::open(&a.0[..b.len()]).map(|t| t.closest(&ray));
+            assert_eq!(got, want.map(|()| mesh.closest(&ray)), "{x} on axis {axis}");
+        }
+    }
+    // A vertex a triangle uses.
+    let mut b = bytes.clone();
+    let at = word(&b, 9) as usize + 12;
+    b[at..at + 4].copy_from_slice(&f32::NAN.to_le_bytes());
+    let a = aligned(&b);
+    assert_eq!(
+        Baked::open(&a.0[..b.len()]).err(),
+        Some(OpenError::Vertex(1))
+    );
+}
+
 /// Issue 31, gap 3: two triangles with one id tied at the same `t` (a shared edge). Rays from
 /// either side visit them in opposite orders, and a packet's lane follows its first lane's
 /// order; the tie rule's last key, the position in the tree, picks the same one (the earlier)
@@ -362,30 +408,62 @@ fn no_mutation_of_a_baked_tree_panics_or_answers_wrongly() {
     let n = word(&bytes, 3) as usize;
     let ids_at = word(&bytes, 8) as usize;
     let id = |b: &[u8], t: usize| [b[ids_at + 2 * t], b[ids_at + 2 * t + 1]];
-    for case in 0..300 {
+    const KINDS: usize = 2;
+    for case in 0..300 * KINDS {
         let mut b = bytes.clone();
-        // Ids duplicated: every id one triangle's, a run of ids its first's, or ids their
-        // neighbours'. The tree opens and answers as brute force at every width.
-        let mode = case % 3;
-        let (from, to) = match mode {
-            0 => (0, n),
-            1 => {
-                let s = rng.random_range(0..n - 1);
-                (s, (s + rng.random_range(2..64)).min(n))
+        let want = match case % KINDS {
+            // Ids duplicated: every id one triangle's, a run of ids its first's, or ids their
+            // neighbours'. The tree opens and answers as brute force at every width.
+            0 => {
+                let mode = case / KINDS % 3;
+                let (from, to) = match mode {
+                    0 => (0, n),
+                    1 => {
+                        let s = rng.random_range(0..n - 1);
+                        (s, (s + rng.random_range(2..64)).min(n))
+                    }
+                    _ => (rng.random_range(0..n / 2), n),
+                };
+                let one = id(&b, rng.random_range(0..n));
+                for t in from..to {
+                    let x = match mode {
+                        0 => one,
+                        1 => id(&b, from),
+                        _ if rng.random_bool(0.5) => id(&b, (t + 1) % n),
+                        _ => id(&b, t),
+                    };
+                    b[ids_at + 2 * t..ids_at + 2 * t + 2].copy_from_slice(&x);
+                }
+                Ok(())
             }
-            _ => (rng.random_range(0..n / 2), n),
+            // A vertex no triangle uses appended (the count and the length raised), or a
+            // vertex overwritten, one coordinate NaN or infinite (or, appended, finite):
+            // refused unless finite.
+            _ => {
+                let nv = word(&b, 4) as usize;
+                let appended = (case / KINDS).is_multiple_of(2);
+                let v = if appended {
+                    b.extend([0.25f32, -0.5, 0.75].iter().flat_map(|x| x.to_le_bytes()));
+                    set_word(&mut b, 4, nv as u32 + 1);
+                    set_len(&mut b);
+                    nv
+                } else {
+                    rng.random_range(0..nv)
+                };
+                let x = if appended && rng.random_bool(0.3) {
+                    [1e30, -0.0, 7.0][rng.random_range(0..3)]
+                } else {
+                    [f32::NAN, f32::INFINITY, f32::NEG_INFINITY][rng.random_range(0..3)]
+                };
+                let at = word(&b, 9) as usize + 12 * v + 4 * rng.random_range(0..3);
+                b[at..at + 4].copy_from_slice(&x.to_le_bytes());
+                if x.is_finite() {
+                    Ok(())
+                } else {
+                    Err(OpenError::Vertex(v as u32))
+                }
+            }
         };
-        let one = id(&b, rng.random_range(0..n));
-        for t in from..to {
-            let x = match mode {
-                0 => one,
-                1 => id(&b, from),
-                _ if rng.random_bool(0.5) => id(&b, (t + 1) % n),
-                _ => id(&b, t),
-            };
-            b[ids_at + 2 * t..ids_at + 2 * t + 2].copy_from_slice(&x);
-        }
-        let want = Ok(());
         let a = aligned(&b);
         let got = answers_if_open(&a.0[..b.len()], &rs).map(|_| ());
         assert_eq!(got, want, "case {case}");
