@@ -35,7 +35,7 @@
 //! | 0–3 | magic `RLBV` |
 //! | 4–5, 6–7 | version (1), flags (bit 0: 32-bit indices, else 16-bit) |
 //! | 8–11, 12–15, 16–19 | nodes, triangles, vertices |
-//! | 20–23 | the tree's depth (the root alone is 1; at most [`MAX_DEPTH4`]) |
+//! | 20–23 | the tree's depth, exactly (the root alone is 1; at most [`MAX_DEPTH4`]) |
 //! | 24–27, 28–31, 32–35, 36–39 | offsets of the nodes, the triangles, their ids, the vertices |
 //! | 40–43 | total length |
 //! | 44–63 | zero |
@@ -72,6 +72,8 @@
 //!     are brute force's over the baked triangles.
 //! 11. No node ([`Order`](OpenError::Order)) and no triangle ([`Leaf`](OpenError::Leaf)) left
 //!     over.
+//! 12. The depth field is the depth the walk reached ([`Depth`](OpenError::Depth)), so that
+//!     [`Baked::depth`] is the tree's.
 //!
 //! Any other input is an error value, never a panic, an out-of-bounds read or a loop. The ids
 //! are not checked: any value is an answer, and two triangles with one id tied at one `t` go
@@ -121,8 +123,10 @@ pub enum OpenError {
     /// Node `.0` has a non-finite origin, an exponent out of range, a nonzero pad or a
     /// non-canonical empty slot.
     Node(u32),
-    /// The tree is deeper than [`MAX_DEPTH4`].
+    /// The tree is deeper than [`MAX_DEPTH4`], or the depth field is 0 or more than it.
     TooDeep,
+    /// The depth field is not the tree's depth, `.0`.
+    Depth(u32),
     /// A leaf of node `.0` holds no triangle, more than 4, or not the next ones.
     Leaf(u32),
     /// Triangle `.0` has a vertex index out of range.
@@ -254,7 +258,10 @@ impl<'a> Baked<'a> {
             reach: 0.0,
             depth,
         };
-        tree.check()?;
+        let deepest = tree.check()?;
+        if deepest != depth {
+            return Err(OpenError::Depth(deepest));
+        }
         tree.reach = super::reach(&nodes[0]);
         Ok(tree)
     }
@@ -280,7 +287,8 @@ impl<'a> Baked<'a> {
         self.nodes
     }
 
-    /// The tree's depth (the root alone is 1).
+    /// The tree's depth (the root alone is 1; the header's field, which opening compared with
+    /// the tree's).
     #[must_use]
     pub fn depth(&self) -> u32 {
         self.depth
@@ -365,17 +373,18 @@ impl<'a> Baked<'a> {
     }
 
     /// The one pass of [`open`](Self::open): a depth-first walk in preorder with the
-    /// intersection of the boxes above each node on the stack.
-    fn check(&self) -> Result<(), OpenError> {
+    /// intersection of the boxes above each node on the stack. Returns the tree's depth.
+    fn check(&self) -> Result<u32, OpenError> {
         // (node, depth, the box every triangle under it must lie in)
         type Entry = (u32, u32, [f32; 3], [f32; 3]);
         let mut stack: [Entry; STACK4] = [(0, 0, [0.0; 3], [0.0; 3]); STACK4];
         stack[0] = (0, 1, [f32::NEG_INFINITY; 3], [f32::INFINITY; 3]);
         let mut sp = 1usize;
-        let (mut next_node, mut next_tri) = (0u32, 0usize);
+        let (mut next_node, mut next_tri, mut deepest) = (0u32, 0usize, 0u32);
         while sp > 0 {
             sp -= 1;
             let (i, d, lo, hi) = stack[sp];
+            deepest = deepest.max(d);
             if i != next_node {
                 return Err(OpenError::Order(i));
             }
@@ -441,7 +450,7 @@ impl<'a> Baked<'a> {
         if next_tri != self.len() {
             return Err(OpenError::Leaf(u32::MAX));
         }
-        Ok(())
+        Ok(deepest)
     }
 
     /// The triangles of the leaf `r` (`first << 2 | (count − 1)`): `(first, count)`.

@@ -8,7 +8,8 @@ use glam::Vec3;
 use rand::rngs::SmallRng;
 use rand::{Rng, SeedableRng};
 use raylane::bvh::bake::{Baked, HEADER, OpenError, bake};
-use raylane::bvh::{LEAF, Node4};
+use raylane::bvh::node::MAX_DEPTH4;
+use raylane::bvh::{EMPTY, LEAF, Node4};
 use raylane::mesh::Mesh;
 use raylane::triangle::{Moller, Triangle};
 use raylane::{Cull, Query, Ray};
@@ -175,9 +176,22 @@ fn brute(tree: &Baked, r: &Ray) -> Option<[u32; 12]> {
 /// nothing panics.
 fn answers_if_open(bytes: &[u8], rays: &[Ray]) -> Result<usize, OpenError> {
     let tree = Baked::open(bytes)?;
+    assert_eq!(tree.depth(), depth_of(tree.nodes(), 0));
     let want: Vec<_> = rays.iter().map(|r| brute(&tree, r)).collect();
     every_width(&tree, rays, &want);
     Ok(want.iter().filter(|w| w.is_some()).count())
+}
+
+/// The depth of the subtree under node `i` (a node alone is 1).
+fn depth_of(nodes: &[Node4], i: usize) -> u32 {
+    let inner = nodes[i]
+        .child
+        .iter()
+        .filter(|&&c| c != EMPTY && c & LEAF == 0);
+    1 + inner
+        .map(|&c| depth_of(nodes, c as usize))
+        .max()
+        .unwrap_or(0)
 }
 
 /// Header word `k` (bytes `4k..4k + 4`).
@@ -325,6 +339,35 @@ fn every_vertex_is_checked_used_or_not() {
     );
 }
 
+/// Issue 31, gap 2: the depth field must be the tree's depth. The baked bunny and the
+/// one-node tree of `two_leaves`, with every depth field from 0 to 17: only the real depth
+/// opens, any other from 1 to [`MAX_DEPTH4`] is refused with the real one, 0 and 17 as too
+/// deep. Fails when the field is taken as written: the bunny opened with any depth from 1
+/// to 16, and `depth()` reported it.
+#[test]
+fn the_depth_field_is_the_trees_depth() {
+    let (pos, idx) = bunny();
+    let bunny = bake(&Mesh::new(&pos, &idx)).unwrap();
+    let one = two_leaves([0, 1], 1);
+    for bytes in [bunny, one] {
+        let real = word(&bytes, 5);
+        let a = aligned(&bytes);
+        let nodes = Baked::open(&a.0[..bytes.len()]).unwrap().nodes().to_vec();
+        assert_eq!(real, depth_of(&nodes, 0));
+        for d in 0..=MAX_DEPTH4 + 1 {
+            let mut b = bytes.clone();
+            set_word(&mut b, 5, d);
+            let a = aligned(&b);
+            let want = match d {
+                _ if d == real => Ok(real),
+                1..=MAX_DEPTH4 => Err(OpenError::Depth(real)),
+                _ => Err(OpenError::TooDeep),
+            };
+            assert_eq!(Baked::open(&a.0[..b.len()]).map(|t| t.depth()), want);
+        }
+    }
+}
+
 /// Issue 31, gap 3: two triangles with one id tied at the same `t` (a shared edge). Rays from
 /// either side visit them in opposite orders, and a packet's lane follows its first lane's
 /// order; the tie rule's last key, the position in the tree, picks the same one (the earlier)
@@ -408,7 +451,8 @@ fn no_mutation_of_a_baked_tree_panics_or_answers_wrongly() {
     let n = word(&bytes, 3) as usize;
     let ids_at = word(&bytes, 8) as usize;
     let id = |b: &[u8], t: usize| [b[ids_at + 2 * t], b[ids_at + 2 * t + 1]];
-    const KINDS: usize = 2;
+    let depth = word(&bytes, 5);
+    const KINDS: usize = 3;
     for case in 0..300 * KINDS {
         let mut b = bytes.clone();
         let want = match case % KINDS {
@@ -435,6 +479,16 @@ fn no_mutation_of_a_baked_tree_panics_or_answers_wrongly() {
                     b[ids_at + 2 * t..ids_at + 2 * t + 2].copy_from_slice(&x);
                 }
                 Ok(())
+            }
+            // The depth field rewritten: refused unless it is the tree's depth.
+            1 => {
+                let d = rng.random_range(0..=MAX_DEPTH4 + 4);
+                set_word(&mut b, 5, d);
+                match d {
+                    _ if d == depth => Ok(()),
+                    1..=MAX_DEPTH4 => Err(OpenError::Depth(depth)),
+                    _ => Err(OpenError::TooDeep),
+                }
             }
             // A vertex no triangle uses appended (the count and the length raised), or a
             // vertex overwritten, one coordinate NaN or infinite (or, appended, finite):
