@@ -28,7 +28,8 @@
 //! a check that refuse a file this crate cannot trace. Opening is one pass over the bytes, no
 //! allocation, no copy.
 //!
-//! **The format** (version 1; every field little-endian, every section 4-byte aligned):
+//! **The format** (version 1; every field little-endian; the sections back to back in the
+//! table's order, each at the first 4-byte boundary after the one before, zero bytes between):
 //!
 //! | bytes | field |
 //! | --- | --- |
@@ -36,10 +37,10 @@
 //! | 4–5, 6–7 | version (1), flags (bit 0: 32-bit indices, else 16-bit) |
 //! | 8–11, 12–15, 16–19 | nodes, triangles, vertices |
 //! | 20–23 | the tree's depth, exactly (the root alone is 1; at most [`MAX_DEPTH4`]) |
-//! | 24–27, 28–31, 32–35, 36–39 | offsets of the nodes, the triangles, their ids, the vertices |
-//! | 40–43 | total length |
+//! | 24–27, 28–31, 32–35, 36–39 | offsets: the nodes (64), the triangles, the ids, the vertices |
+//! | 40–43 | total length: the end of the vertices |
 //! | 44–63 | zero |
-//! | nodes | [`Node4`], 56 bytes each, depth-first preorder (the root first) |
+//! | nodes | [`Node4`], 56 bytes each, depth-first preorder (the root first), each with a child |
 //! | triangles | vertex indices A, B, C per triangle (`u16` or `u32`), in leaf order |
 //! | ids | the triangle's index in the mesh that was baked (`u16` or `u32`), the index hits report |
 //! | vertices | `f32` x, y, z |
@@ -56,28 +57,34 @@
 //! 5. The total length is the number of bytes ([`Truncated`](OpenError::Truncated)).
 //! 6. At least one node ([`Order(0)`](OpenError::Order)).
 //! 7. The depth field from 1 to [`MAX_DEPTH4`] ([`TooDeep`](OpenError::TooDeep)).
-//! 8. Each section at a 4-byte boundary after the header ([`Header`](OpenError::Header)) and
-//!    inside the bytes ([`Truncated`](OpenError::Truncated)).
+//! 8. Each offset the one the counts give, the bytes between sections zero
+//!    ([`Header`](OpenError::Header)), and the bytes ending with the vertices: fewer are
+//!    [`Truncated`](OpenError::Truncated), more [`Header`](OpenError::Header).
 //! 9. Every vertex finite, whether a triangle uses it or not ([`Vertex`](OpenError::Vertex)):
 //!    a NaN or an infinity anywhere is a sign of corruption.
 //! 10. From the root, depth first: each node the next one in preorder, so every node is reached
 //!     exactly once (a tree: none reached twice, none left out, every child after its parent;
 //!     [`Order`](OpenError::Order)); its pad zero, its origin finite, its exponents in
-//!     −126…127, its unused slots canonical (`lo` 255, `hi` 0; [`Node`](OpenError::Node)); no
-//!     inner child below depth [`MAX_DEPTH4`] ([`TooDeep`](OpenError::TooDeep)); each leaf 1 to
-//!     4 triangles, the next ones in order, none skipped or shared
-//!     ([`Leaf`](OpenError::Leaf)); each triangle's vertex indices in range
-//!     ([`Triangle`](OpenError::Triangle)); and each of its vertices inside the decoded box of
-//!     every node above it ([`Outside`](OpenError::Outside)), so that the traversal's answers
-//!     are brute force's over the baked triangles.
+//!     −126…127, its unused slots canonical (`lo` 255, `hi` 0), a child unless it is the root
+//!     ([`Node`](OpenError::Node)); no inner child below depth [`MAX_DEPTH4`]
+//!     ([`TooDeep`](OpenError::TooDeep)); each leaf 1 to 4 triangles, the next ones in order,
+//!     none skipped or shared ([`Leaf`](OpenError::Leaf)); each triangle's vertex indices in
+//!     range ([`Triangle`](OpenError::Triangle)); and each of its vertices inside the decoded
+//!     box of every node above it ([`Outside`](OpenError::Outside)), so that the traversal's
+//!     answers are brute force's over the baked triangles.
 //! 11. No node ([`Order`](OpenError::Order)) and no triangle ([`Leaf`](OpenError::Leaf)) left
 //!     over.
 //! 12. The depth field is the depth the walk reached ([`Depth`](OpenError::Depth)), so that
 //!     [`Baked::depth`] is the tree's.
 //!
-//! Any other input is an error value, never a panic, an out-of-bounds read or a loop. The ids
-//! are not checked: any value is an answer, and two triangles with one id tied at one `t` go
-//! to the earlier one in leaf order at every width (the tie rule's last key, [`crate::hit`]).
+//! Any other input is an error value, never a panic, an out-of-bounds read or a loop. So these
+//! are refused: bytes after the last section, sections that overlap or leave a gap (or a
+//! nonzero byte in the padding between them), and nodes without children, but for the root of
+//! a tree of no triangles (as `bake` writes it for an empty mesh): `bake` writes none of them,
+//! and each is a sign of corruption. Allowed: vertices no triangle uses (if finite), and any
+//! ids, repeated ones too (a check would need scratch memory or quadratic time): two triangles
+//! with one id tied at one `t` go to the earlier one in leaf order, at every width (the tie
+//! rule's last key, [`crate::hit`]).
 
 use glam::Vec3;
 use wide::f32x4;
@@ -114,14 +121,15 @@ pub enum OpenError {
     Magic,
     /// Another version of the format.
     Version(u16),
-    /// Unknown flags, a nonzero reserved field, or a section out of place.
+    /// Unknown flags, a nonzero reserved field or byte between sections, a section not where
+    /// the format puts it (overlapping another, or after a gap), or bytes after the last one.
     Header,
     /// The host this runs on is big-endian (the format is little-endian).
     BigEndian,
     /// Node `.0` is not where a tree in preorder puts it, or is reached twice or not at all.
     Order(u32),
-    /// Node `.0` has a non-finite origin, an exponent out of range, a nonzero pad or a
-    /// non-canonical empty slot.
+    /// Node `.0` has a non-finite origin, an exponent out of range, a nonzero pad, a
+    /// non-canonical empty slot, or no child (allowed at the root alone).
     Node(u32),
     /// The tree is deeper than [`MAX_DEPTH4`], or the depth field is 0 or more than it.
     TooDeep,
@@ -180,17 +188,27 @@ fn u32_at(b: &[u8], at: usize) -> Option<u32> {
     Some(u32::from_le_bytes(b.get(at..at + 4)?.try_into().ok()?))
 }
 
-/// `bytes[off..off + n·size]` as `&[T]`, checked.
-fn section<T: bytemuck::Pod>(bytes: &[u8], off: u32, n: u32) -> Result<&[T], OpenError> {
-    let size = core::mem::size_of::<T>();
-    let len = (n as usize).checked_mul(size).ok_or(OpenError::Truncated)?;
-    let start = off as usize;
-    let end = start.checked_add(len).ok_or(OpenError::Truncated)?;
-    if !start.is_multiple_of(4) || start < HEADER {
-        return Err(OpenError::Header);
-    }
-    let b = bytes.get(start..end).ok_or(OpenError::Truncated)?;
+/// `bytes[start..start + n·size]` as `&[T]`, checked.
+fn section<T: bytemuck::Pod>(bytes: &[u8], start: usize, n: u32) -> Result<&[T], OpenError> {
+    let len = (n as usize).checked_mul(core::mem::size_of::<T>());
+    let b = len
+        .and_then(|len| bytes.get(start..start.checked_add(len)?))
+        .ok_or(OpenError::Truncated)?;
     bytemuck::try_cast_slice(b).map_err(|_| OpenError::Misaligned)
+}
+
+/// Where the format puts the nodes, the triangles, the ids and the vertices, and where the
+/// vertices end, for these counts and index `width` (bytes): back to back after the header,
+/// each at the first 4-byte boundary after the one before; `None` past `usize`.
+fn layout(n_nodes: u32, n_tris: u32, n_verts: u32, width: usize) -> Option<[usize; 5]> {
+    let after = |at: usize, n: u32, size: usize| {
+        at.checked_add((n as usize).checked_mul(size)?)?
+            .checked_next_multiple_of(4)
+    };
+    let tris = after(HEADER, n_nodes, size_of::<Node4>())?;
+    let ids = after(tris, n_tris, 3 * width)?;
+    let verts = after(ids, n_tris, width)?;
+    Some([HEADER, tris, ids, verts, after(verts, n_verts, 12)?])
 }
 
 impl<'a> Baked<'a> {
@@ -231,19 +249,41 @@ impl<'a> Baked<'a> {
         if depth == 0 || depth > MAX_DEPTH4 {
             return Err(OpenError::TooDeep);
         }
-        let nodes: &[Node4] = section(bytes, word(6), n_nodes)?;
-        let (tris, ids) = if flags & WIDE != 0 {
+        // The sections where the format puts them, zero bytes between, nothing after.
+        let width = if flags & WIDE != 0 { 4 } else { 2 };
+        let at = layout(n_nodes, n_tris, n_verts, width).ok_or(OpenError::Truncated)?;
+        if (0..4).any(|k| word(6 + k) as usize != at[k]) {
+            return Err(OpenError::Header);
+        }
+        if at[4] != bytes.len() {
+            return Err(if at[4] > bytes.len() {
+                OpenError::Truncated
+            } else {
+                OpenError::Header
+            });
+        }
+        let n = n_tris as usize;
+        let zero = |from: usize, to: usize| {
+            bytes
+                .get(from..to)
+                .is_some_and(|b| b.iter().all(|&x| x == 0))
+        };
+        if !zero(at[1] + 3 * width * n, at[2]) || !zero(at[2] + width * n, at[3]) {
+            return Err(OpenError::Header);
+        }
+        let nodes: &[Node4] = section(bytes, at[0], n_nodes)?;
+        let (tris, ids) = if width == 4 {
             (
-                Tris::Wide(section(bytes, word(7), n_tris)?),
-                Ids::Wide(section(bytes, word(8), n_tris)?),
+                Tris::Wide(section(bytes, at[1], n_tris)?),
+                Ids::Wide(section(bytes, at[2], n_tris)?),
             )
         } else {
             (
-                Tris::Narrow(section(bytes, word(7), n_tris)?),
-                Ids::Narrow(section(bytes, word(8), n_tris)?),
+                Tris::Narrow(section(bytes, at[1], n_tris)?),
+                Ids::Narrow(section(bytes, at[2], n_tris)?),
             )
         };
-        let vertices: &[[f32; 3]] = section(bytes, word(9), n_verts)?;
+        let vertices: &[[f32; 3]] = section(bytes, at[3], n_verts)?;
         if let Some(v) = vertices
             .iter()
             .position(|p| !p.iter().all(|x| x.is_finite()))
@@ -394,6 +434,7 @@ impl<'a> Baked<'a> {
             if n.pad != 0
                 || !n.origin.iter().all(|x| x.is_finite())
                 || !n.exp.iter().all(|e| (-126..=127).contains(e))
+                || (i != 0 && n.child.iter().all(|&c| c == EMPTY))
             {
                 return Err(bad);
             }

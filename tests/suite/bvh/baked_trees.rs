@@ -208,6 +208,15 @@ fn set_len(b: &mut [u8]) {
     set_word(b, 10, b.len() as u32);
 }
 
+/// A [`Node4`]'s 56 bytes, field by field.
+fn push_node(b: &mut Vec<u8>, n: &Node4) {
+    n.origin.iter().for_each(|x| b.extend(x.to_le_bytes()));
+    b.extend(n.exp.map(|e| e as u8));
+    b.push(n.pad);
+    n.lo.iter().chain(&n.hi).for_each(|q| b.extend(q));
+    n.child.iter().for_each(|c| b.extend(c.to_le_bytes()));
+}
+
 /// A tree with 16-bit indices written by hand, field by field as the module docs' table
 /// lays them out (`bake` writes the same layout).
 fn image(
@@ -220,13 +229,7 @@ fn image(
     let mut b = vec![0u8; HEADER];
     let align = |b: &mut Vec<u8>| b.resize(b.len().next_multiple_of(4), 0);
     let off_nodes = b.len();
-    for n in nodes {
-        n.origin.iter().for_each(|x| b.extend(x.to_le_bytes()));
-        b.extend(n.exp.map(|e| e as u8));
-        b.push(n.pad);
-        n.lo.iter().chain(&n.hi).for_each(|q| b.extend(q));
-        n.child.iter().for_each(|c| b.extend(c.to_le_bytes()));
-    }
+    nodes.iter().for_each(|n| push_node(&mut b, n));
     let off_tris = b.len();
     tris.iter()
         .flatten()
@@ -264,6 +267,12 @@ fn image(
 /// right B's; both hit the shared edge at `t = 1` in both triangles (with other `u`, `v` and
 /// normals). The ids are the caller's.
 fn two_leaves(ids: [u16; 2], depth: u32) -> Vec<u8> {
+    let (root, verts) = two_leaf_root();
+    image(&[root], &[[0, 1, 2], [1, 3, 2]], &ids, &verts, depth)
+}
+
+/// `two_leaves`' root and vertices.
+fn two_leaf_root() -> (Node4, [[f32; 3]; 4]) {
     let verts = [
         [-1.0, 0.0, 0.5],
         [0.0, 0.0, 0.0],
@@ -283,7 +292,7 @@ fn two_leaves(ids: [u16; 2], depth: u32) -> Vec<u8> {
         (root.lo[2][k], root.hi[2][k]) = (0, 128);
         root.child[k] = LEAF | (k as u32) << 2; // one triangle, the k-th
     }
-    image(&[root], &[[0, 1, 2], [1, 3, 2]], &ids, &verts, depth)
+    (root, verts)
 }
 
 /// A ray from the left and one from the right at the point `(0, 1/2, 0)` of `two_leaves`' shared
@@ -366,6 +375,63 @@ fn the_depth_field_is_the_trees_depth() {
             assert_eq!(Baked::open(&a.0[..b.len()]).map(|t| t.depth()), want);
         }
     }
+}
+
+/// Issue 31, what the format allows: nothing after the last section, sections neither
+/// overlapping nor apart, zero bytes between them, and every node with a child but for the
+/// root of a tree of no triangles. Before, every edit below of a valid image opened, but the
+/// vertices read from the ids (refused as outside their boxes).
+#[test]
+fn opening_refuses_what_the_format_does_not_allow() {
+    let pos = [Vec3::ZERO, Vec3::X, Vec3::Y];
+    let bytes = bake(&Mesh::new(&pos, &[[0, 1, 2]])).unwrap();
+    let open = |b: &[u8]| Baked::open(&aligned(b).0[..b.len()]).err();
+    assert_eq!(open(&bytes), None);
+    // Bytes after the last section (the length raised to match).
+    for extra in [1, 4, 12] {
+        let mut b = bytes.clone();
+        b.extend(vec![0; extra]);
+        set_len(&mut b);
+        assert_eq!(open(&b), Some(OpenError::Header), "{extra} bytes after");
+    }
+    // Sections that overlap: the ids read from the triangles' indices, the vertices from
+    // the ids.
+    for (k, from) in [(8, 7), (9, 8)] {
+        let mut b = bytes.clone();
+        let x = word(&b, from);
+        set_word(&mut b, k, x);
+        assert_eq!(open(&b), Some(OpenError::Header), "word {k} = word {from}");
+    }
+    // Sections apart: 4 bytes before the vertices (their offset and the length raised).
+    let mut b = bytes.clone();
+    let at = word(&b, 9);
+    b.splice(at as usize..at as usize, [0; 4]);
+    set_word(&mut b, 9, at + 4);
+    set_len(&mut b);
+    assert_eq!(open(&b), Some(OpenError::Header));
+    // A nonzero byte between sections: after the triangles' 6 bytes, after the ids' 2.
+    for at in [word(&bytes, 7) + 6, word(&bytes, 8) + 2] {
+        let mut b = bytes.clone();
+        b[at as usize] = 1;
+        assert_eq!(open(&b), Some(OpenError::Header), "byte {at}");
+    }
+    // A node without children: the second slot of `two_leaves`' root made an inner node
+    // that has none (triangle A alone, depth 2).
+    let (mut root, verts) = two_leaf_root();
+    root.child[1] = 1;
+    let b = image(&[root, Node4::EMPTY], &[[0, 1, 2]], &[0], &verts, 2);
+    assert_eq!(open(&b), Some(OpenError::Node(1)));
+    root.child[1] = EMPTY;
+    for a in 0..3 {
+        (root.lo[a][1], root.hi[a][1]) = (255, 0);
+    }
+    let b = image(&[root], &[[0, 1, 2]], &[0], &verts, 1);
+    assert_eq!(open(&b), None, "the same tree without it");
+    // The root of a tree of no triangles has none, as `bake` writes it for an empty mesh.
+    let empty = bake(&Mesh::new(&[], &[])).unwrap();
+    let a = aligned(&empty);
+    let tree = Baked::open(&a.0[..empty.len()]).unwrap();
+    assert_eq!((tree.len(), tree.nodes()[0].child), (0, [EMPTY; 4]));
 }
 
 /// Issue 31, gap 3: two triangles with one id tied at the same `t` (a shared edge). Rays from
@@ -452,7 +518,18 @@ fn no_mutation_of_a_baked_tree_panics_or_answers_wrongly() {
     let ids_at = word(&bytes, 8) as usize;
     let id = |b: &[u8], t: usize| [b[ids_at + 2 * t], b[ids_at + 2 * t + 1]];
     let depth = word(&bytes, 5);
-    const KINDS: usize = 3;
+    let nodes = Baked::open(&aligned(&bytes).0[..bytes.len()])
+        .unwrap()
+        .nodes()
+        .to_vec();
+    // Nodes whose children are all leaves, with a slot free.
+    let parents: Vec<usize> = (0..nodes.len())
+        .filter(|&p| {
+            let c = nodes[p].child;
+            c.contains(&EMPTY) && c.iter().all(|&c| c == EMPTY || c & LEAF != 0)
+        })
+        .collect();
+    const KINDS: usize = 5;
     for case in 0..300 * KINDS {
         let mut b = bytes.clone();
         let want = match case % KINDS {
@@ -489,6 +566,53 @@ fn no_mutation_of_a_baked_tree_panics_or_answers_wrongly() {
                     1..=MAX_DEPTH4 => Err(OpenError::Depth(depth)),
                     _ => Err(OpenError::TooDeep),
                 }
+            }
+            // A node without children inserted in the free slot of a node whose children are
+            // leaves (the nodes after it renumbered, the sections moved, the counts, offsets,
+            // length and depth made to match): refused.
+            2 => {
+                let p = parents[rng.random_range(0..parents.len())];
+                let mut ns = nodes.clone();
+                for c in ns.iter_mut().flat_map(|n| &mut n.child) {
+                    if *c != EMPTY && *c & LEAF == 0 && *c > p as u32 {
+                        *c += 1;
+                    }
+                }
+                let k = ns[p].child.iter().position(|&c| c == EMPTY).unwrap();
+                ns[p].child[k] = p as u32 + 1;
+                for a in 0..3 {
+                    ns[p].lo[a][k] = ns[p].lo[a][0];
+                    ns[p].hi[a][k] = ns[p].hi[a][0];
+                }
+                ns.insert(p + 1, Node4::EMPTY);
+                let mut e = b[..HEADER].to_vec();
+                ns.iter().for_each(|n| push_node(&mut e, n));
+                e.extend(&b[word(&b, 7) as usize..]);
+                set_word(&mut e, 2, ns.len() as u32);
+                set_word(&mut e, 5, depth_of(&ns, 0));
+                for k in 7..10 {
+                    set_word(&mut e, k, word(&b, k) + 56);
+                }
+                set_len(&mut e);
+                b = e;
+                Err(OpenError::Node(p as u32 + 1))
+            }
+            // Bytes after the vertices (the length raised to match), or a section's offset
+            // moved (by 4 bytes, or onto another section): refused.
+            3 => {
+                if rng.random_bool(0.5) {
+                    b.extend((0..rng.random_range(1..=16)).map(|_| rng.random::<u8>()));
+                    set_len(&mut b);
+                } else {
+                    let k = rng.random_range(6..10);
+                    let x = match rng.random_range(0..3) {
+                        0 => word(&b, k) + 4,
+                        1 => word(&b, k) - 4,
+                        _ => word(&b, 6 + (k - 6 + rng.random_range(1..4)) % 4),
+                    };
+                    set_word(&mut b, k, x);
+                }
+                Err(OpenError::Header)
             }
             // A vertex no triangle uses appended (the count and the length raised), or a
             // vertex overwritten, one coordinate NaN or infinite (or, appended, finite):
