@@ -25,7 +25,7 @@
 //! **Why bytes, not generated Rust.** A firmware developer bakes with the rest of the assets
 //! (a `build.rs` or the `bake` example) and links the file with `include_bytes!`: no large
 //! generated source to compile, the same file for every target and toolchain, and a version and
-//! a check that refuse a file this crate cannot trace. Opening is one pass over the bytes, no
+//! a check that refuse a file this crate cannot trace. Opening reads the bytes in linear time, no
 //! allocation, no copy.
 //!
 //! **The format** (version 1; every field little-endian; the sections back to back in the
@@ -412,7 +412,7 @@ impl<'a> Baked<'a> {
         }
     }
 
-    /// The one pass of [`open`](Self::open): a depth-first walk in preorder with the
+    /// The tree pass of [`open`](Self::open): a depth-first walk in preorder with the
     /// intersection of the boxes above each node on the stack. Returns the tree's depth.
     fn check(&self) -> Result<u32, OpenError> {
         // (node, depth, the box every triangle under it must lie in)
