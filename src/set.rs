@@ -351,12 +351,7 @@ pub(crate) fn filtered<L: Lane, E, C: Collector<L>>(
         }
     };
     if L::LANES == 1 {
-        // The index from the entry's address, not a counter: it is needed only where an
-        // entry is offered, and the miss path then keeps one induction variable.
-        let base = entries.as_ptr() as usize;
-        let size = core::mem::size_of::<E>().max(1);
-        for e in entries {
-            let i = (e as *const E as usize - base) / size;
+        for (i, e) in entries.iter().enumerate() {
             if one(&mut r, i, e, c) {
                 return true;
             }
