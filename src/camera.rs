@@ -174,7 +174,8 @@ pub struct Tile<'c, L: Lane, const W: usize, const H: usize> {
 
 impl<L: Lane, const W: usize, const H: usize> Tile<'_, L, W, H> {
     /// Each block of the tile, row by row: its offset in the tile and its packet.
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     pub fn packets(&self) -> impl Iterator<Item = (usize, usize, RayPacket<L>)> + '_ {
         let (bw, bh) = const {
             let (bw, bh) = block::<L>();

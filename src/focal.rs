@@ -181,7 +181,8 @@ impl<'c> FocalMesh<'c> {
     }
 
     /// The lanes `at` (from the eye) through the focal kernel.
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn focal<L: Lane, C: Collector<L>>(
         &self,
         rays: &RayPacket<L>,
@@ -246,7 +247,8 @@ impl<'c> FocalMesh<'c> {
 /// tested against the entries in index order (two passes per block of 64: the edge signs
 /// first); others go to the mesh.
 impl Trace for FocalMesh<'_> {
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
         let at = at_eye(rays, self.eye);
         if at.any() && self.focal(rays, at, set, c) {
@@ -259,7 +261,8 @@ impl Trace for FocalMesh<'_> {
                 .trace_with::<Watertight, L, C>(self.cull, &only(rays, other), set, c)
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
         self.mesh.records_with(self.cull, rays, set, w)
     }
@@ -327,7 +330,8 @@ impl<'c> FocalSpheres<'c> {
 /// tested against the entries in index order (two passes per block of 64: the cheap test
 /// first); others go to the spheres with [`Robust`].
 impl Trace for FocalSpheres<'_> {
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
         let e = rays.dir.length_squared() - L::from_f32(1.0);
         let at = at_eye(rays, self.eye) & e.abs().le(L::from_f32(UNIT_TOLERANCE));
@@ -366,7 +370,8 @@ impl Trace for FocalSpheres<'_> {
             && flat::<Sphere, Robust, L, C>(rays, other, cull, set, c, self.spheres.iter().copied())
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
         Sphere::records(rays, &mine(w, set), self.cull, |i| {
             self.spheres.get(w.loc(i)? as usize).copied()
@@ -435,7 +440,8 @@ impl<'c> FocalPlanes<'c> {
 /// Focal planes (see the [module docs](self)): N rays × 1 plane in index order; rays from
 /// elsewhere go to the planes.
 impl Trace for FocalPlanes<'_> {
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
         let eyed = at_eye(rays, self.eye);
         let cull = self.cull;
@@ -477,7 +483,8 @@ impl Trace for FocalPlanes<'_> {
             )
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
         Plane::records(rays, &mine(w, set), self.cull, |i| {
             self.planes.get(w.loc(i)? as usize).copied()

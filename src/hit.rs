@@ -90,6 +90,24 @@ pub struct Hits<L: Lane> {
 }
 
 impl<L: Lane> Hits<L> {
+    /// The records a query made in the lanes it runs in ([`Lane::Run`]), in `L`'s.
+    #[inline(always)]
+    #[must_use]
+    pub fn from_run(h: Hits<L::Run>) -> Self {
+        let v = |v: V3<L::Run>| V3::new(L::from_run(v.x), L::from_run(v.y), L::from_run(v.z));
+        Hits {
+            t: L::from_run(h.t),
+            point: v(h.point),
+            normal: v(h.normal),
+            front: L::mask_from_run(h.front),
+            index: L::indices_from_run(h.index),
+            set: L::indices_from_run(h.set),
+            u: L::from_run(h.u),
+            v: L::from_run(h.v),
+            mask: L::mask_from_run(h.mask),
+        }
+    }
+
     /// No lane hits.
     #[inline]
     #[must_use]
@@ -129,7 +147,8 @@ impl<L: Lane> Hits<L> {
     }
 
     /// Writes one ray's record into lane `i` (a miss clears it).
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     pub(crate) fn set_lane(&mut self, i: usize, h: Option<&Hit>) {
         let s = |x: f32| L::Scalar::from_f32(x);
         let h = match h {
@@ -609,7 +628,8 @@ pub trait Record: Primitive {
 /// Spheres: normal `(o + t·d − c)/|o + t·d − c|` (3 add, 3 mul, 2 add, 1 sqrt, 3 div), flipped
 /// for exit roots (marked by `u = 1`).
 impl Record for Sphere {
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(
         rays: &RayPacket<L>,
         w: &Winners<L>,
@@ -642,7 +662,8 @@ impl Record for Sphere {
 /// 2 add, 1 sqrt, 3 div), facing the origin; front: `d·N/|N| < 0` (3 mul, 2 add, 1 cmp), or
 /// every hit under [`Cull::Back`] (the kernel decided it).
 impl Record for Triangle {
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(
         rays: &RayPacket<L>,
         w: &Winners<L>,
@@ -675,7 +696,8 @@ impl Record for Triangle {
 
 /// Planes: normal `n/|n|` facing the origin, front `d·n < 0`.
 impl Record for Plane {
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(
         rays: &RayPacket<L>,
         w: &Winners<L>,

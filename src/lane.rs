@@ -20,6 +20,10 @@ use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
 use wide::{f32x4, f32x8, f32x16};
 
+mod portable;
+
+pub use portable::{X8, X16};
+
 /// The element type of a lane: `f32` or `f64`.
 pub trait Scalar: Copy + Debug + PartialOrd + Default + 'static {
     /// Widens to `f64` (exact for both `f32` and `f64`).
@@ -206,6 +210,11 @@ pub trait Lane:
     /// of them may continue lane by lane through the one-ray traversal (the same answers).
     /// False for counting and higher-precision lanes, whose work stays in the lane type.
     const PLAIN_F32: bool = false;
+    /// The lane type a query runs a packet of these in (the same lanes, the same bits): on
+    /// x86-64 raylane's own [`X8`] and [`X16`] for `wide`'s 8 and 16 lanes, which the
+    /// [run-time level](crate::simd) compiles to its widest registers (`wide`'s keep the
+    /// representation of the build); `Self` for every other lane type and target.
+    type Run: Lane<Scalar = Self::Scalar>;
 
     /// The same value in every lane.
     fn splat(x: Self::Scalar) -> Self;
@@ -262,6 +271,16 @@ pub trait Lane:
     }
     /// Lane `i` as a single higher-precision lane (exact widening).
     fn precise_lane(self, i: usize) -> Self::Precise;
+    /// The same lanes as [`Run`](Self::Run).
+    fn into_run(self) -> Self::Run;
+    /// The same lanes from [`Run`](Self::Run).
+    fn from_run(x: Self::Run) -> Self;
+    /// A mask as [`Run`](Self::Run)'s.
+    fn mask_into_run(m: Self::Mask) -> <Self::Run as Lane>::Mask;
+    /// A mask from [`Run`](Self::Run)'s.
+    fn mask_from_run(m: <Self::Run as Lane>::Mask) -> Self::Mask;
+    /// Indices from [`Run`](Self::Run)'s.
+    fn indices_from_run(i: <Self::Run as Lane>::Indices) -> Self::Indices;
 
     /// Builds a lane value from `f32` elements (exact).
     #[inline(always)]
@@ -385,6 +404,7 @@ fn finite_f32(x: f32) -> bool {
 
 impl Lane for f32 {
     const PLAIN_F32: bool = true;
+    type Run = f32;
     type Scalar = f32;
     type Mask = bool;
     type Precise = f64;
@@ -454,9 +474,30 @@ impl Lane for f32 {
     fn precise_lane(self, _i: usize) -> f64 {
         self as f64
     }
+    #[inline(always)]
+    fn into_run(self) -> Self {
+        self
+    }
+    #[inline(always)]
+    fn from_run(x: Self) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn mask_into_run(m: bool) -> bool {
+        m
+    }
+    #[inline(always)]
+    fn mask_from_run(m: bool) -> bool {
+        m
+    }
+    #[inline(always)]
+    fn indices_from_run(i: [u32; 1]) -> [u32; 1] {
+        i
+    }
 }
 
 impl Lane for f64 {
+    type Run = f64;
     type Scalar = f64;
     type Mask = bool;
     type Precise = f64;
@@ -515,12 +556,32 @@ impl Lane for f64 {
     fn precise_lane(self, _i: usize) -> f64 {
         self
     }
+    #[inline(always)]
+    fn into_run(self) -> Self {
+        self
+    }
+    #[inline(always)]
+    fn from_run(x: Self) -> Self {
+        x
+    }
+    #[inline(always)]
+    fn mask_into_run(m: bool) -> bool {
+        m
+    }
+    #[inline(always)]
+    fn mask_from_run(m: bool) -> bool {
+        m
+    }
+    #[inline(always)]
+    fn indices_from_run(i: [u32; 1]) -> [u32; 1] {
+        i
+    }
 }
 
 /// Implements [`Mask`] and [`Lane`] for a `wide` f32 vector type: one macro, so the widths
 /// cannot drift apart.
 macro_rules! wide_lane {
-    ($t:ident, $n:literal, $max:ident) => {
+    ($t:ident, $n:literal, $max:ident, $run:ty) => {
         impl Mask for $t {
             #[inline(always)]
             fn splat(b: bool) -> Self {
@@ -551,6 +612,7 @@ macro_rules! wide_lane {
             type Mask = $t;
             type Precise = f64;
             type Indices = [u32; $n];
+            type Run = $run;
             const LANES: usize = $n;
             const PLAIN_F32: bool = true;
 
@@ -654,6 +716,26 @@ macro_rules! wide_lane {
             fn max_lane(self) -> f32 {
                 $max(self)
             }
+            #[inline(always)]
+            fn into_run(self) -> $run {
+                bytemuck::cast(self)
+            }
+            #[inline(always)]
+            fn from_run(x: $run) -> Self {
+                bytemuck::cast(x)
+            }
+            #[inline(always)]
+            fn mask_into_run(m: Self) -> $run {
+                bytemuck::cast(m)
+            }
+            #[inline(always)]
+            fn mask_from_run(m: $run) -> Self {
+                bytemuck::cast(m)
+            }
+            #[inline(always)]
+            fn indices_from_run(i: [u32; $n]) -> [u32; $n] {
+                i
+            }
         }
     };
 }
@@ -689,9 +771,15 @@ fn max16(v: f32x16) -> f32 {
     max8(hi.simd_gt(lo).select(hi, lo))
 }
 
-wide_lane!(f32x4, 4, max4);
-wide_lane!(f32x8, 8, max8);
-wide_lane!(f32x16, 16, max16);
+wide_lane!(f32x4, 4, max4, f32x4);
+#[cfg(target_arch = "x86_64")]
+wide_lane!(f32x8, 8, max8, X8);
+#[cfg(target_arch = "x86_64")]
+wide_lane!(f32x16, 16, max16, X16);
+#[cfg(not(target_arch = "x86_64"))]
+wide_lane!(f32x8, 8, max8, f32x8);
+#[cfg(not(target_arch = "x86_64"))]
+wide_lane!(f32x16, 16, max16, f32x16);
 
 #[cfg(test)]
 mod tests {

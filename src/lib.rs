@@ -71,6 +71,7 @@ pub mod plane;
 pub mod query;
 pub mod ray;
 pub mod set;
+pub mod simd;
 pub mod sphere;
 pub mod triangle;
 pub mod vec3;

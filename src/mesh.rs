@@ -204,7 +204,8 @@ impl Set for Mesh<'_> {
     type Prim = Triangle;
     type Kernel = Watertight;
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_with<K: Kernel<Triangle>, L: Lane, C: Collector<L>>(
         &self,
         cull: Cull,
@@ -224,7 +225,8 @@ impl Set for Mesh<'_> {
             )
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,

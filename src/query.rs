@@ -68,6 +68,7 @@ use crate::kernel::{Cull, Kernel};
 use crate::lane::{Lane, Mask};
 use crate::ray::{Ray, RayPacket};
 use crate::set::{Set, Trace, Using};
+use crate::simd;
 
 /// The one query vocabulary (see the [module docs](self)): closest hit, occlusion and every
 /// hit, for a ray or a packet, over any set. Every lane of a packet answer equals the one-ray
@@ -142,35 +143,73 @@ impl Rays for Ray {
 
     #[inline]
     fn closest<T: Trace + ?Sized>(t: &T, ray: &Ray) -> Option<Hit> {
-        let packet = RayPacket::<f32>::splat(ray);
-        let mut c = Closest::new(&packet);
-        t.trace_ray(ray, 0, &mut c);
-        let w = c.finish();
-        if !w.mask {
-            return None;
-        }
-        t.records(&packet, 0, &w).lane(0)
+        simd::run(
+            #[inline(always)]
+            || closest_ray(t, ray),
+        )
     }
 
     #[inline]
     fn any<T: Trace + ?Sized>(t: &T, ray: &Ray) -> bool {
-        let mut c = Any::new(&RayPacket::<f32>::splat(ray));
-        t.trace_ray(ray, 0, &mut c);
-        c.finish()
+        simd::run(
+            #[inline(always)]
+            || {
+                let mut c = Any::new(&RayPacket::<f32>::splat(ray));
+                t.trace_ray(ray, 0, &mut c);
+                c.finish()
+            },
+        )
     }
 
     #[inline]
     fn all<T: Trace + ?Sized>(t: &T, ray: &Ray, f: &mut dyn FnMut(Hit)) {
-        let packet = RayPacket::<f32>::splat(ray);
-        let mut c = All::new(&packet, |h: &Hits<f32>| {
-            if let Some(h) = h.lane(0) {
-                f(h)
-            }
-        });
-        t.trace(&packet, 0, &mut c);
+        simd::run(
+            #[inline(always)]
+            || {
+                let packet = RayPacket::<f32>::splat(ray);
+                let mut c = All::new(&packet, |h: &Hits<f32>| {
+                    if let Some(h) = h.lane(0) {
+                        f(h)
+                    }
+                });
+                t.trace(&packet, 0, &mut c);
+            },
+        )
     }
 }
 
+/// One ray's closest hit and its record (the body [`Rays::closest`] runs at the
+/// [level](crate::simd)).
+#[cfg_attr(target_arch = "x86_64", inline(always))]
+fn closest_ray<T: Trace + ?Sized>(t: &T, ray: &Ray) -> Option<Hit> {
+    let packet = RayPacket::<f32>::splat(ray);
+    let mut c = Closest::new(&packet);
+    t.trace_ray(ray, 0, &mut c);
+    let w = c.finish();
+    if !w.mask {
+        return None;
+    }
+    t.records(&packet, 0, &w).lane(0)
+}
+
+/// A packet's closest hits and their records, in the lanes queries run in.
+#[cfg_attr(target_arch = "x86_64", inline(always))]
+fn closest_packet<T: Trace + ?Sized, L: Lane>(t: &T, rays: &RayPacket<L>) -> Hits<L> {
+    let mut c = Closest::new(rays);
+    t.trace(rays, 0, &mut c);
+    t.records(rays, 0, &c.finish())
+}
+
+/// A packet's occlusion, in the lanes queries run in.
+#[cfg_attr(target_arch = "x86_64", inline(always))]
+fn any_packet<T: Trace + ?Sized, L: Lane>(t: &T, rays: &RayPacket<L>) -> L::Mask {
+    let mut c = Any::new(rays);
+    t.trace(rays, 0, &mut c);
+    c.finish()
+}
+
+/// Packets run in [`Lane::Run`]'s lanes (raylane's own vectors for `wide`'s 8 and 16 on
+/// x86-64), at the [level](crate::simd) chosen when the program runs: the same bits.
 impl<L: Lane> Rays for RayPacket<L> {
     type Closest = Hits<L>;
     type Any = L::Mask;
@@ -178,25 +217,36 @@ impl<L: Lane> Rays for RayPacket<L> {
 
     #[inline]
     fn closest<T: Trace + ?Sized>(t: &T, rays: &Self) -> Hits<L> {
-        let mut c = Closest::new(rays);
-        t.trace(rays, 0, &mut c);
-        t.records(rays, 0, &c.finish())
+        let r = rays.into_run();
+        Hits::from_run(simd::run(
+            #[inline(always)]
+            || closest_packet(t, &r),
+        ))
     }
 
     #[inline]
     fn any<T: Trace + ?Sized>(t: &T, rays: &Self) -> L::Mask {
-        let mut c = Any::new(rays);
-        t.trace(rays, 0, &mut c);
-        c.finish()
+        let r = rays.into_run();
+        L::mask_from_run(simd::run(
+            #[inline(always)]
+            || any_packet(t, &r),
+        ))
     }
 
     #[inline]
     fn all<T: Trace + ?Sized>(t: &T, rays: &Self, f: &mut dyn FnMut(Hits<L>)) {
-        let mut c = All::new(rays, |h: &Hits<L>| f(*h));
-        t.trace(rays, 0, &mut c);
+        let r = rays.into_run();
+        simd::run(
+            #[inline(always)]
+            || {
+                let mut c = All::new(&r, |h: &Hits<L::Run>| f(Hits::from_run(*h)));
+                t.trace(&r, 0, &mut c);
+            },
+        )
     }
 }
 
+/// A tile enters the [level](crate::simd) once, its packets in [`Lane::Run`]'s lanes.
 impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L, W, H> {
     type Closest = [[Option<Hit>; W]; H];
     type Any = [[bool; W]; H];
@@ -205,42 +255,59 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
 
     #[inline]
     fn closest<T: Trace + ?Sized>(t: &T, tile: &Self) -> [[Option<Hit>; W]; H] {
-        let mut out = [[None; W]; H];
-        for (dx, dy, rays) in tile.packets() {
-            let hits = RayPacket::closest(t, &rays);
-            for i in 0..L::LANES {
-                let (px, py) = block_lane::<L>(i);
-                out[dy + py][dx + px] = hits.lane(i);
-            }
-        }
-        out
+        simd::run(
+            #[inline(always)]
+            || {
+                let mut out = [[None; W]; H];
+                for (dx, dy, rays) in tile.packets() {
+                    let hits = closest_packet(t, &rays.into_run());
+                    for i in 0..L::LANES {
+                        let (px, py) = block_lane::<L>(i);
+                        out[dy + py][dx + px] = hits.lane(i);
+                    }
+                }
+                out
+            },
+        )
     }
 
     #[inline]
     fn any<T: Trace + ?Sized>(t: &T, tile: &Self) -> [[bool; W]; H] {
-        let mut out = [[false; W]; H];
-        for (dx, dy, rays) in tile.packets() {
-            let hit = RayPacket::any(t, &rays);
-            for i in 0..L::LANES {
-                let (px, py) = block_lane::<L>(i);
-                out[dy + py][dx + px] = hit.test(i);
-            }
-        }
-        out
+        simd::run(
+            #[inline(always)]
+            || {
+                let mut out = [[false; W]; H];
+                for (dx, dy, rays) in tile.packets() {
+                    let hit = any_packet(t, &rays.into_run());
+                    for i in 0..L::LANES {
+                        let (px, py) = block_lane::<L>(i);
+                        out[dy + py][dx + px] = hit.test(i);
+                    }
+                }
+                out
+            },
+        )
     }
 
     #[inline]
     fn all<T: Trace + ?Sized>(t: &T, tile: &Self, f: &mut dyn FnMut((u32, u32, Hit))) {
         let (x, y) = tile.origin();
-        for (dx, dy, rays) in tile.packets() {
-            RayPacket::all(t, &rays, &mut |h: Hits<L>| {
-                for i in 0..L::LANES {
-                    if let Some(hit) = h.lane(i) {
-                        let (px, py) = block_lane::<L>(i);
-                        f((x + (dx + px) as u32, y + (dy + py) as u32, hit));
-                    }
+        simd::run(
+            #[inline(always)]
+            || {
+                for (dx, dy, rays) in tile.packets() {
+                    let r = rays.into_run();
+                    let mut c = All::new(&r, |h: &Hits<L::Run>| {
+                        for i in 0..L::LANES {
+                            if let Some(hit) = h.lane(i) {
+                                let (px, py) = block_lane::<L>(i);
+                                f((x + (dx + px) as u32, y + (dy + py) as u32, hit));
+                            }
+                        }
+                    });
+                    t.trace(&r, 0, &mut c);
                 }
-            });
-        }
+            },
+        )
     }
 }

@@ -27,7 +27,8 @@ use crate::triangle::{Triangle, Watertight};
 pub trait Trace {
     /// How many values of [`Hit::set`](crate::Hit::set) it uses from its `set` on: 1 for a set,
     /// the instances of a [`Scene`](crate::bvh::Scene), the sum for a tuple.
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
         1
     }
@@ -37,7 +38,8 @@ pub trait Trace {
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool;
 
     /// [`trace`](Self::trace) for one ray (sets with a faster one-ray path override it).
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
         self.trace(&RayPacket::<f32>::splat(ray), set, c)
     }
@@ -56,7 +58,8 @@ pub trait Set {
     type Kernel: Kernel<Self::Prim>;
 
     /// As [`Trace::sets`].
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
         1
     }
@@ -71,7 +74,8 @@ pub trait Set {
     ) -> bool;
 
     /// [`Trace::trace_ray`] with kernel `K`, culled by `cull`.
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray_with<K: Kernel<Self::Prim>, C: Collector<f32>>(
         &self,
         cull: Cull,
@@ -138,38 +142,46 @@ impl<'a, S: ?Sized, K> Using<'a, S, K> {
 }
 
 impl<S: Set + ?Sized> Trace for S {
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
         Set::sets(self)
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
         self.trace_with::<S::Kernel, L, C>(Cull::None, rays, set, c)
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
         self.trace_ray_with::<S::Kernel, C>(Cull::None, ray, set, c)
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
         self.records_with(Cull::None, rays, set, w)
     }
 }
 
 impl<S: Set + ?Sized, K: Kernel<S::Prim>> Trace for Using<'_, S, K> {
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
         Set::sets(self.set)
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
         self.set.trace_with::<K, L, C>(self.cull, rays, set, c)
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
         self.set.trace_ray_with::<K, C>(self.cull, ray, set, c)
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
         self.set.records_with(self.cull, rays, set, w)
     }
@@ -178,11 +190,13 @@ impl<S: Set + ?Sized, K: Kernel<S::Prim>> Trace for Using<'_, S, K> {
 impl<S: Set + ?Sized> Set for &S {
     type Prim = S::Prim;
     type Kernel = S::Kernel;
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
         (**self).sets()
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_with<K: Kernel<S::Prim>, L: Lane, C: Collector<L>>(
         &self,
         cull: Cull,
@@ -192,7 +206,8 @@ impl<S: Set + ?Sized> Set for &S {
     ) -> bool {
         (**self).trace_with::<K, L, C>(cull, rays, set, c)
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray_with<K: Kernel<S::Prim>, C: Collector<f32>>(
         &self,
         cull: Cull,
@@ -202,7 +217,8 @@ impl<S: Set + ?Sized> Set for &S {
     ) -> bool {
         (**self).trace_ray_with::<K, C>(cull, ray, set, c)
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,
@@ -376,7 +392,8 @@ pub(crate) fn filtered<L: Lane, E, C: Collector<L>>(
 impl Set for [Sphere] {
     type Prim = Sphere;
     type Kernel = Robust;
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_with<K: Kernel<Sphere>, L: Lane, C: Collector<L>>(
         &self,
         cull: Cull,
@@ -387,7 +404,8 @@ impl Set for [Sphere] {
         let all = Mask::splat(true);
         flat::<Sphere, K, L, C>(rays, all, cull, set, c, self.iter().copied())
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,
@@ -404,7 +422,8 @@ impl Set for [Sphere] {
 impl Set for [Triangle] {
     type Prim = Triangle;
     type Kernel = Watertight;
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_with<K: Kernel<Triangle>, L: Lane, C: Collector<L>>(
         &self,
         cull: Cull,
@@ -415,7 +434,8 @@ impl Set for [Triangle] {
         let all = Mask::splat(true);
         flat::<Triangle, K, L, C>(rays, all, cull, set, c, self.iter().copied())
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,
@@ -432,7 +452,8 @@ impl Set for [Triangle] {
 impl Set for [Plane] {
     type Prim = Plane;
     type Kernel = PlaneTest;
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_with<K: Kernel<Plane>, L: Lane, C: Collector<L>>(
         &self,
         cull: Cull,
@@ -443,7 +464,8 @@ impl Set for [Plane] {
         let all = Mask::splat(true);
         flat::<Plane, K, L, C>(rays, all, cull, set, c, self.iter().copied())
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,
@@ -513,12 +535,14 @@ pub(crate) fn select_hits<L: Lane>(m: L::Mask, a: &Hits<L>, b: &Hits<L>) -> Hits
 macro_rules! tuple {
     ($($q:ident $i:tt),+) => {
         impl<$($q: Trace),+> Trace for ($($q,)+) {
-            #[inline]
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            #[cfg_attr(not(target_arch = "x86_64"), inline)]
             fn sets(&self) -> u32 {
                 0 $(+ self.$i.sets())+
             }
 
-            #[inline]
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            #[cfg_attr(not(target_arch = "x86_64"), inline)]
             fn trace<L: Lane, Co: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut Co) -> bool {
                 let mut base = set;
                 $(
@@ -531,7 +555,8 @@ macro_rules! tuple {
                 false
             }
 
-            #[inline]
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            #[cfg_attr(not(target_arch = "x86_64"), inline)]
             fn trace_ray<Co: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut Co) -> bool {
                 let mut base = set;
                 $(

@@ -302,8 +302,10 @@ macro_rules! registry {
                 }
             }
 
-            /// Calls the visitor's method for this kernel's family, with its type.
-            #[inline]
+            /// Calls the visitor's method for this kernel's family, with its type (inline on
+            /// x86-64, so that it runs at the level its caller entered: `raylane::simd`).
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            #[cfg_attr(not(target_arch = "x86_64"), inline)]
             pub fn visit<V: Visitor>(self, v: V) -> V::Output {
                 match self {
                     $( $( Kernel::$kernel => {

@@ -525,16 +525,24 @@ pub fn evaluate(method: Method, lanes: usize, cases: &[Case], out: &mut [Outcome
     if out.len() < cases.len() {
         return false;
     }
-    match lanes {
-        1 => run::<f32>(method, cases, out),
-        4 => run::<wide::f32x4>(method, cases, out),
-        8 => run::<wide::f32x8>(method, cases, out),
-        16 => run::<wide::f32x16>(method, cases, out),
-        _ => return false,
+    if ![1, 4, 8, 16].contains(&lanes) {
+        return false;
     }
+    // At the run-time SIMD level, in the lanes queries run in (raylane::simd, Lane::Run): the
+    // digests of a default x86-64 build then cover every level (RAYLANE_SIMD).
+    raylane::simd::run(
+        #[inline(always)]
+        || match lanes {
+            1 => run::<f32>(method, cases, out),
+            4 => run::<<wide::f32x4 as Lane>::Run>(method, cases, out),
+            8 => run::<<wide::f32x8 as Lane>::Run>(method, cases, out),
+            _ => run::<<wide::f32x16 as Lane>::Run>(method, cases, out),
+        },
+    );
     true
 }
 
+#[cfg_attr(target_arch = "x86_64", inline(always))]
 fn run<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome]) {
     let mut i = 0;
     while i < cases.len() {
@@ -550,6 +558,7 @@ fn run<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome
 
 /// Evaluates up to `L::LANES` cases of one kind in one packet: the method's kernel for the
 /// kind, through the [registry](crate::registry).
+#[cfg_attr(target_arch = "x86_64", inline(always))]
 fn batch<L: Lane<Scalar = f32>>(method: Method, cases: &[Case], out: &mut [Outcome]) {
     raylane::lane::assert_fits::<L>();
     match method.kernel(cases[0].kind) {
@@ -623,19 +632,22 @@ fn case_lane(cases: &[Case], i: usize) -> Case {
     cases[i.min(cases.len() - 1)]
 }
 
-// Each family out of line: their caches (up to 16 lanes of focal entries) then never share
-// one stack frame (the Cortex-M0 has 16 KB of RAM).
+// Each family out of line on the boards: their caches (up to 16 lanes of focal entries) then
+// never share one stack frame (the Cortex-M0 has 16 KB of RAM). Inline on x86-64, so that
+// they run at the level `evaluate` entered (raylane::simd).
 impl<L: Lane<Scalar = f32>> Visitor for Batch<'_, L> {
     type Output = ();
 
-    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline(never))]
     fn sphere<K: SphereKernel>(self, _: Kernel) {
         let spheres = SpherePacket::<L>::from_spheres(&sphere_list(self.cases));
         let roots = K::roots(&self.ray, &spheres);
         self.roots(roots);
     }
 
-    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline(never))]
     fn focal_sphere<K: FocalKernel>(self, _: Kernel, guarded: bool) {
         // A per-case cache with the eye at the ray origin.
         let mut e =
@@ -652,7 +664,8 @@ impl<L: Lane<Scalar = f32>> Visitor for Batch<'_, L> {
         self.roots(roots);
     }
 
-    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline(never))]
     fn plane(self, _: Kernel) {
         let planes = PlanePacket::<L> {
             point: V3::from_fn(|i| self.get(i).vec(0)),
@@ -662,7 +675,8 @@ impl<L: Lane<Scalar = f32>> Visitor for Batch<'_, L> {
         self.hits(h, false);
     }
 
-    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline(never))]
     fn focal_plane(self, _: Kernel) {
         let num =
             L::from_f32_fn(|i| FocalPlane::new(self.get(i).origin(), &self.get(i).plane()).num());
@@ -670,14 +684,16 @@ impl<L: Lane<Scalar = f32>> Visitor for Batch<'_, L> {
         self.hits(h, false);
     }
 
-    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline(never))]
     fn triangle<K: TriangleKernel>(self, _: Kernel) {
         let tris = TrianglePacket::<L>::from_fn(|i| self.get(i).triangle());
         let h = K::intersect(&self.ray, &K::prepare(&self.ray), &tris, Cull::None).normalized();
         self.hits(h, true);
     }
 
-    #[inline(never)]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline(never))]
     fn focal_triangle(self, _: Kernel) {
         // A per-case cache with the eye at the ray origin.
         let mut e = [FocalTriangle::never(); MAX_LANES];

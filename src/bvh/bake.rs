@@ -452,8 +452,9 @@ impl<'a> Baked<'a> {
                 }
                 // The child's box, within the boxes above.
                 let (blo, bhi) = n.bounds(k);
-                let clo: [f32; 3] = core::array::from_fn(|a| super::max(lo[a], blo[a]));
-                let chi: [f32; 3] = core::array::from_fn(|a| super::min(hi[a], bhi[a]));
+                let clo = |a: usize| super::max(lo[a], blo[a]);
+                let chi = |a: usize| super::min(hi[a], bhi[a]);
+                let (clo, chi) = ([clo(0), clo(1), clo(2)], [chi(0), chi(1), chi(2)]);
                 if c & LEAF == 0 {
                     inner[m] = (c, clo, chi);
                     m += 1;
@@ -592,7 +593,8 @@ impl Set for Baked<'_> {
     type Prim = Triangle;
     type Kernel = Watertight;
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_with<K: Kernel<Triangle>, L: Lane, C: Collector<L>>(
         &self,
         cull: Cull,
@@ -648,7 +650,8 @@ impl Set for Baked<'_> {
         )
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray_with<K: Kernel<Triangle>, C: Collector<f32>>(
         &self,
         cull: Cull,
@@ -665,7 +668,8 @@ impl Set for Baked<'_> {
         self.trace_from::<K, C>(cull, ray, 0, set, c)
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,

@@ -152,7 +152,8 @@ impl Leaf for Tri4 {
     type Prim = Triangle;
     type Kernel = Watertight;
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn prim(&self, k: usize) -> Triangle {
         self.triangle(k)
     }
@@ -219,7 +220,8 @@ impl Leaf for Sphere4 {
     type Prim = Sphere;
     type Kernel = Robust;
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn prim(&self, k: usize) -> Sphere {
         Sphere::new(get(&self.center, k), self.radius[k])
     }

@@ -649,7 +649,8 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
     type Prim = P::Prim;
     type Kernel = P::Kernel;
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_with<K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
         &self,
         cull: Cull,
@@ -676,7 +677,8 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
         )
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
         &self,
         cull: Cull,
@@ -693,7 +695,8 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
         self.trace_from::<K, C>(cull, ray, 0, set, c)
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,
@@ -866,7 +869,8 @@ impl<P: Leaf> Set for OwnedBvh<P> {
     type Prim = P::Prim;
     type Kernel = P::Kernel;
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_with<K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
         &self,
         cull: Cull,
@@ -877,7 +881,8 @@ impl<P: Leaf> Set for OwnedBvh<P> {
         self.view().trace_with::<K, L, C>(cull, rays, set, c)
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
         &self,
         cull: Cull,
@@ -888,7 +893,8 @@ impl<P: Leaf> Set for OwnedBvh<P> {
         self.view().trace_ray_with::<K, C>(cull, ray, set, c)
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,

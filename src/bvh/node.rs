@@ -11,7 +11,14 @@
 //! interval arithmetic ([`Frustum`]), conservative by monotonic rounding.
 
 use glam::Vec3;
-use wide::{f32x4, f32x8, i32x4};
+use wide::{f32x4, i32x4};
+
+/// A node's 8 children in lanes: raylane's own [`X8`](crate::lane::X8) on x86-64, which the
+/// query's [run-time level](crate::simd) compiles to one AVX register; `wide`'s elsewhere.
+#[cfg(target_arch = "x86_64")]
+type F8 = crate::lane::X8;
+#[cfg(not(target_arch = "x86_64"))]
+type F8 = wide::f32x8;
 
 use super::{EMPTY, MAX_DEPTH, STACK, WIDTH};
 use crate::lane::{Lane, Mask};
@@ -198,7 +205,8 @@ impl Layout for Node {
         self.child.get(k).copied().unwrap_or(EMPTY)
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]) {
         let b = &self.bounds;
         let get = |a: usize| b[a].get(k).copied().unwrap_or(f32::NAN);
@@ -355,7 +363,8 @@ impl Layout for Node4 {
         self.child.get(k).copied().unwrap_or(EMPTY)
     }
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]) {
         if k >= 4 || self.child[k] == EMPTY {
             return ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
@@ -507,24 +516,27 @@ impl Slab {
         }
         // `(b − o)·inv`, or fused `b·inv − o·inv` with `o·inv` made once per ray: 6 fewer
         // instructions per node.
-        let plane = |p: usize, o: f32, q: f32, inv: f32| {
-            let b = f32x8::new(b[p]);
+        // A function, not a closure: called six times, a closure may be left out of line, and
+        // then run at the baseline inside a query entered at a wider level (crate::simd).
+        #[inline(always)]
+        fn plane(b: &[f32; WIDTH], o: f32, q: f32, inv: f32) -> F8 {
+            let b = F8::new(*b);
             if FUSED {
-                b.mul_add(f32x8::splat(inv), f32x8::splat(-q))
+                b.mul_add(F8::splat(inv), F8::splat(-q))
             } else {
-                (b - f32x8::splat(o)) * inv
+                (b - F8::splat(o)) * inv
             }
-        };
+        }
         let (n, f) = (self.near, self.far);
         let (on, of, qn, qf, inv) = (self.on, self.of, self.qn, self.qf, self.inv);
-        let tn = f32x8::splat(t_min)
-            .fast_max(plane(n[0], on[0], qn[0], inv[0]))
-            .fast_max(plane(n[1], on[1], qn[1], inv[1]))
-            .fast_max(plane(n[2], on[2], qn[2], inv[2]));
-        let tf = f32x8::splat(t_max)
-            .fast_min(plane(f[0], of[0], qf[0], inv[0]))
-            .fast_min(plane(f[1], of[1], qf[1], inv[1]))
-            .fast_min(plane(f[2], of[2], qf[2], inv[2]));
+        let tn = F8::splat(t_min)
+            .fast_max(plane(&b[n[0]], on[0], qn[0], inv[0]))
+            .fast_max(plane(&b[n[1]], on[1], qn[1], inv[1]))
+            .fast_max(plane(&b[n[2]], on[2], qn[2], inv[2]));
+        let tf = F8::splat(t_max)
+            .fast_min(plane(&b[f[0]], of[0], qf[0], inv[0]))
+            .fast_min(plane(&b[f[1]], of[1], qf[1], inv[1]))
+            .fast_min(plane(&b[f[2]], of[2], qf[2], inv[2]));
         (tn.simd_le(tf).to_bitmask(), tn.to_array())
     }
 
@@ -622,6 +634,7 @@ pub(crate) fn lmin<L: Lane>(a: L, b: L) -> L {
 }
 
 impl<L: Lane> PacketSlab<L> {
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub(crate) fn new(rays: &RayPacket<L>, reach: f32) -> Self {
         let (o, d) = (rays.origin, rays.dir);
         let omax = lmax(lmax(o.x.abs(), o.y.abs()), o.z.abs());
@@ -742,7 +755,7 @@ impl Frustum {
     /// parameters.
     #[inline(always)]
     pub fn test(&self, b: &[[f32; WIDTH]; 6], t_lo: f32, t_hi: f32) -> (u32, [f32; WIDTH]) {
-        let (bits, tn) = self.test_rows(|r| f32x8::new(b[r]), t_lo, t_hi);
+        let (bits, tn) = self.test_rows(|r| F8::new(b[r]), t_lo, t_hi);
         (bits, tn.to_array())
     }
 
@@ -803,7 +816,7 @@ macro_rules! row {
     };
 }
 row!(f32x4);
-row!(f32x8);
+row!(F8);
 
 /// The highest value of the `valid` lanes (none NaN: valid rays have no NaN constants).
 #[inline(always)]

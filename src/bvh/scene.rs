@@ -95,6 +95,7 @@ impl Instance {
 
     /// The world ray in object space (see the [module docs](self)).
     #[must_use]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub fn ray_to_object(&self, ray: &Ray) -> Ray {
         let m = &self.to_object;
         let (o, d) = (ray.origin(), ray.dir());
@@ -112,6 +113,7 @@ impl Instance {
     /// [`ray_to_object`](Self::ray_to_object) (the same operations, so the same bits), over
     /// the same intervals.
     #[must_use]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub fn packet_to_object<L: Lane>(&self, rays: &RayPacket<L>) -> RayPacket<L> {
         let m = &self.to_object;
         let (o, d) = (rays.origin, rays.dir);
@@ -178,10 +180,12 @@ impl Packed for Inst4 {
         index: [EMPTY; LEAF_WIDTH],
     };
 
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     fn indices(&self) -> &[u32; LEAF_WIDTH] {
         &self.index
     }
 
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     fn bounds(&self, k: usize) -> ([f32; 3], [f32; 3]) {
         let b = &self.bounds;
         ([b[0][k], b[1][k], b[2][k]], [b[3][k], b[4][k], b[5][k]])
@@ -199,6 +203,7 @@ impl<P: Packed, N: Layout> Primitives for Placed<'_, '_, P, N> {
     fn count(&self) -> usize {
         self.instances.len()
     }
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     fn bounds(&self, i: u32) -> ([f32; 3], [f32; 3]) {
         let Some(inst) = self.instances.get(i as usize) else {
             return ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
@@ -271,6 +276,7 @@ impl<'s, P: Leaf, N: Layout> Scene<'s, P, N> {
     }
 
     /// An object record in world space: point on the world ray, normal `Mᵀ·n` normalised.
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     fn world_record(inst: &Instance, i: u32, ray: &Ray, h: Hit) -> Hit {
         let m = &inst.to_object;
         let n = h.normal;
@@ -301,7 +307,8 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
     type Prim = P::Prim;
     type Kernel = P::Kernel;
 
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
         self.instances.len() as u32
     }
@@ -414,6 +421,7 @@ fn lane<L: Lane>(x: L, j: usize) -> f32 {
 }
 
 /// Lane `j` of a packet as a scalar ray (`None` for an empty interval).
+#[cfg_attr(target_arch = "x86_64", inline(always))]
 fn lane_ray<L: Lane>(rays: &RayPacket<L>, j: usize) -> Option<Ray> {
     let v = |v: V3<L>| Vec3::new(lane(v.x, j), lane(v.y, j), lane(v.z, j));
     let r = Ray::with_interval(

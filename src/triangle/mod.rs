@@ -200,7 +200,8 @@ impl<L: Lane> TrianglePacket<L> {
     }
 
     /// Lane `i` holds `f(i)`.
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     #[must_use]
     pub fn from_fn(mut f: impl FnMut(usize) -> Triangle) -> Self {
         crate::lane::assert_fits::<L>();

@@ -7,7 +7,7 @@ use std::path::Path;
 
 /// The layers, lowest first, as ARCHITECTURE.md draws them.
 const LAYERS: [&[&str]; 6] = [
-    &["lane", "opcount"],
+    &["lane", "opcount", "simd"],
     &["vec3", "ray", "camera"],
     &["kernel", "sphere", "plane", "triangle", "bounds"],
     &["hit"],

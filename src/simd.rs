@@ -1,0 +1,310 @@
+//! The SIMD level queries run at, chosen when the program runs.
+//!
+//! A plain `cargo build` for x86-64 targets the baseline (SSE2), because the binary must run on
+//! every x86-64 CPU. raylane's queries nevertheless run the widest instructions the CPU has:
+//! every [`Query`](crate::Query) (and the BVH build) enters one of three copies of the same
+//! generic code, compiled for
+//!
+//! | [`Level`] | instructions | when |
+//! | --- | --- | --- |
+//! | [`Level::Baseline`] | SSE2 (x86-64), NEON (AArch64), the target's own elsewhere | always |
+//! | [`Level::Avx2`] | x86-64-v3: AVX2, FMA, BMI1/2, LZCNT, MOVBE, F16C | the CPU and the OS support them |
+//! | [`Level::Avx512`] | x86-64-v4: the above and AVX-512 F, BW, CD, DQ, VL | likewise |
+//!
+//! The level is detected once (`cpuid`, and `xgetbv` for the OS's saving of the vector
+//! registers; no `std` needed) and chosen at the query's entry, never per node or kernel.
+//! Below the entry nothing knows about levels: the code is the crate's one generic body, its
+//! 8- and 16-lane vectors raylane's own ([`X8`](crate::lane::X8),
+//! [`X16`](crate::lane::X16): arrays the compiler turns into the level's widest registers),
+//! and every operation a correctly rounded IEEE operation with no fused multiply-add. **Every
+//! level gives the same bits**; only a BVH's box test, which only prunes, may differ in which
+//! boxes it opens (fused where the build itself targets FMA, see [`bvh`](crate::bvh)).
+//!
+//! A build for the CPU (`-C target-cpu=native`) or for a level (`x86-64-v3`) already runs
+//! those instructions everywhere: the entry then calls the code directly. Other targets
+//! (AArch64, whose baseline is NEON; Cortex-M; RISC-V) have one level and compile what they
+//! always did.
+//!
+//! **Forcing a level** (tests and benchmarks): [`force`], or with feature `std` the environment
+//! variable `RAYLANE_SIMD` (`baseline`, `avx2` or `avx512`), read at the first query. A level
+//! the CPU lacks is refused ([`Unsupported`]; the variable then leaves the detected level
+//! and prints a warning), never executed.
+//!
+//! ```
+//! // What this machine runs, and that forcing the baseline always works.
+//! let best = raylane::simd::level();
+//! assert!(raylane::simd::supported(best));
+//! raylane::simd::force(raylane::simd::Level::Baseline).unwrap();
+//! assert_eq!(raylane::simd::level(), raylane::simd::Level::Baseline);
+//! raylane::simd::force(best).unwrap();
+//! ```
+
+use core::sync::atomic::{AtomicU8, Ordering};
+
+/// A SIMD level (see the [module docs](self)).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Level {
+    /// The target's baseline: SSE2 on x86-64, NEON on AArch64.
+    Baseline,
+    /// x86-64-v3: AVX2 and FMA (and BMI1/2, LZCNT, MOVBE, F16C).
+    Avx2,
+    /// x86-64-v4: x86-64-v3 and AVX-512 F, BW, CD, DQ, VL.
+    Avx512,
+}
+
+impl Level {
+    /// Every level, lowest first.
+    pub const ALL: [Level; 3] = [Level::Baseline, Level::Avx2, Level::Avx512];
+
+    /// What it is called, as `RAYLANE_SIMD` takes it: `baseline`, `avx2`, `avx512`.
+    #[must_use]
+    pub const fn name(self) -> &'static str {
+        match self {
+            Level::Baseline => "baseline",
+            Level::Avx2 => "avx2",
+            Level::Avx512 => "avx512",
+        }
+    }
+
+    /// The level called `name` (see [`name`](Self::name)).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Level> {
+        Level::ALL.into_iter().find(|l| l.name() == name)
+    }
+
+    /// The instructions it runs, for people: `SSE2`, `AVX2+FMA`, `AVX-512` (x86-64), `NEON`
+    /// (AArch64), `scalar` elsewhere.
+    #[must_use]
+    pub const fn describe(self) -> &'static str {
+        match self {
+            Level::Avx2 => "AVX2+FMA",
+            Level::Avx512 => "AVX-512",
+            Level::Baseline if cfg!(target_arch = "x86_64") => "SSE2",
+            Level::Baseline if cfg!(target_arch = "aarch64") => "NEON",
+            Level::Baseline => "scalar",
+        }
+    }
+
+    /// f32 lanes per register at this level: 4, 8 or 16 (1 without SIMD).
+    #[must_use]
+    pub const fn lanes(self) -> usize {
+        match self {
+            Level::Avx512 => 16,
+            Level::Avx2 => 8,
+            Level::Baseline if cfg!(any(target_arch = "x86_64", target_arch = "aarch64")) => 4,
+            Level::Baseline => 1,
+        }
+    }
+}
+
+impl core::fmt::Display for Level {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.describe())
+    }
+}
+
+/// A level the CPU (or the target) does not support: refused by [`force`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Unsupported(pub Level);
+
+impl core::fmt::Display for Unsupported {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        write!(
+            f,
+            "this CPU does not support the SIMD level {}",
+            self.0.name()
+        )
+    }
+}
+
+/// The chosen level: 0 until detected, else `Level as u8 + 1`.
+static CHOSEN: AtomicU8 = AtomicU8::new(0);
+
+/// The level queries run at: the best the CPU supports, unless [`force`]d (or, with `std`,
+/// set by `RAYLANE_SIMD`). Detected at the first call.
+#[inline]
+#[must_use]
+pub fn level() -> Level {
+    match CHOSEN.load(Ordering::Relaxed) {
+        2 => Level::Avx2,
+        3 => Level::Avx512,
+        1 => Level::Baseline,
+        _ => choose(),
+    }
+}
+
+/// Runs queries at `level` from now on, in every thread.
+///
+/// # Errors
+///
+/// [`Unsupported`] when the CPU lacks it (nothing changes).
+pub fn force(level: Level) -> Result<(), Unsupported> {
+    if !supported(level) {
+        return Err(Unsupported(level));
+    }
+    CHOSEN.store(level as u8 + 1, Ordering::Relaxed);
+    Ok(())
+}
+
+/// True when this CPU (and target) can run `level`.
+#[must_use]
+pub fn supported(level: Level) -> bool {
+    level <= best()
+}
+
+/// Detects, applies `RAYLANE_SIMD` (with `std`), stores and returns the level.
+#[cold]
+fn choose() -> Level {
+    #[cfg_attr(not(feature = "std"), allow(unused_mut))]
+    let mut chosen = best();
+    #[cfg(feature = "std")]
+    if let Ok(name) = std::env::var("RAYLANE_SIMD") {
+        match Level::from_name(name.trim()) {
+            Some(l) if supported(l) => chosen = l,
+            Some(l) => std::eprintln!(
+                "raylane: RAYLANE_SIMD={name}: {}; running {}",
+                Unsupported(l),
+                chosen.name()
+            ),
+            None => std::eprintln!(
+                "raylane: RAYLANE_SIMD={name} is not a level (baseline, avx2, avx512); running {}",
+                chosen.name()
+            ),
+        }
+    }
+    CHOSEN.store(chosen as u8 + 1, Ordering::Relaxed);
+    chosen
+}
+
+/// The best level of this CPU (the compile-time features count as present).
+fn best() -> Level {
+    #[cfg(target_arch = "x86_64")]
+    {
+        x86::best()
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        Level::Baseline
+    }
+}
+
+/// Runs `f` compiled for the chosen [`level`]: the queries' entry (see the
+/// [module docs](self)). `f` and everything it calls should be `#[inline(always)]` (the
+/// crate's query paths are): what is not inlined into the level's copy runs at the baseline
+/// (the same answers, slower).
+#[inline(always)]
+pub fn run<R>(f: impl FnOnce() -> R) -> R {
+    #[cfg(target_arch = "x86_64")]
+    {
+        x86::run(level(), f)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        f()
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod x86 {
+    use super::Level;
+
+    /// True when the build itself targets AVX-512 (or only AVX2): no run-time copies needed.
+    const BUILT_V4: bool = cfg!(all(
+        target_feature = "avx512f",
+        target_feature = "avx512bw",
+        target_feature = "avx512cd",
+        target_feature = "avx512dq",
+        target_feature = "avx512vl",
+        target_feature = "avx2",
+        target_feature = "fma",
+    ));
+    const BUILT_V3: bool = cfg!(all(target_feature = "avx2", target_feature = "fma"));
+
+    /// The level of `f`'s copy: [`Level::Avx512`] and [`Level::Avx2`] run the copies compiled
+    /// for them (the caller checked the CPU through [`super::level`]).
+    #[inline(always)]
+    pub(super) fn run<R>(level: Level, f: impl FnOnce() -> R) -> R {
+        if BUILT_V4 {
+            return f();
+        }
+        match level {
+            // SAFETY: `level()` returns Avx512 only when `best()` found every v4 feature in
+            // `cpuid` and the OS saving the AVX-512 state in XCR0 (`force` refuses more).
+            Level::Avx512 => unsafe { v4(f) },
+            // SAFETY: likewise for the v3 features and the AVX state.
+            Level::Avx2 if !BUILT_V3 => unsafe { v3(f) },
+            _ => f(),
+        }
+    }
+
+    /// `f` compiled for x86-64-v3.
+    #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,movbe,f16c,popcnt")]
+    unsafe fn v3<R>(f: impl FnOnce() -> R) -> R {
+        f()
+    }
+
+    /// `f` compiled for x86-64-v4.
+    #[target_feature(enable = "avx,avx2,fma,bmi1,bmi2,lzcnt,movbe,f16c,popcnt")]
+    #[target_feature(enable = "avx512f,avx512bw,avx512cd,avx512dq,avx512vl")]
+    unsafe fn v4<R>(f: impl FnOnce() -> R) -> R {
+        f()
+    }
+
+    /// The best level from `cpuid` and `xgetbv` (no `std` needed).
+    pub(super) fn best() -> Level {
+        if BUILT_V4 {
+            return Level::Avx512;
+        }
+        use core::arch::x86_64::{__cpuid, __cpuid_count};
+        let bit = |x: u32, b: u32| x & (1 << b) != 0;
+        // SAFETY: `cpuid` exists on every x86-64 CPU; leaves 1 and 7 exist when leaf 0's
+        // maximum says so (checked), and 0x8000_0001 when 0x8000_0000's does.
+        #[allow(unused_unsafe)]
+        let (max, max_ext) = unsafe { (__cpuid(0).eax, __cpuid(0x8000_0000).eax) };
+        if max < 7 || max_ext < 0x8000_0001 {
+            return Level::Baseline;
+        }
+        // SAFETY: as above.
+        #[allow(unused_unsafe)]
+        let (l1, l7, ext) = unsafe { (__cpuid(1), __cpuid_count(7, 0), __cpuid(0x8000_0001)) };
+        // The OS saves the vector registers (XCR0) only if it set OSXSAVE.
+        if !bit(l1.ecx, 27) {
+            return Level::Baseline;
+        }
+        // SAFETY: OSXSAVE is set, so `xgetbv` exists and XCR0 is readable.
+        let xcr0 = unsafe { xcr0() };
+        let ymm = xcr0 & 0b110 == 0b110;
+        let zmm = xcr0 & 0b1110_0110 == 0b1110_0110;
+        let v3 = ymm
+            && bit(l1.ecx, 28) // AVX
+            && bit(l1.ecx, 12) // FMA
+            && bit(l1.ecx, 22) // MOVBE
+            && bit(l1.ecx, 23) // POPCNT
+            && bit(l1.ecx, 29) // F16C
+            && bit(l7.ebx, 5) // AVX2
+            && bit(l7.ebx, 3) // BMI1
+            && bit(l7.ebx, 8) // BMI2
+            && bit(ext.ecx, 5); // LZCNT
+        let v4 = v3
+            && zmm
+            && bit(l7.ebx, 16) // AVX512F
+            && bit(l7.ebx, 17) // AVX512DQ
+            && bit(l7.ebx, 28) // AVX512CD
+            && bit(l7.ebx, 30) // AVX512BW
+            && bit(l7.ebx, 31); // AVX512VL
+        if v4 {
+            Level::Avx512
+        } else if v3 || BUILT_V3 {
+            Level::Avx2
+        } else {
+            Level::Baseline
+        }
+    }
+
+    /// XCR0, the state components the OS saves.
+    #[target_feature(enable = "xsave")]
+    unsafe fn xcr0() -> u64 {
+        // SAFETY: the caller checked OSXSAVE; reading XCR0 has no side effect.
+        unsafe { core::arch::x86_64::_xgetbv(0) }
+    }
+}
