@@ -8,7 +8,7 @@
 //!                      all six)
 //!   --obj FILE         render a Wavefront OBJ through the BVH (alone, unless scenes are named)
 //!   --size WxH         panel size (default per scene)
-//!   --lanes N          rays per packet: 1, 4, 8 or 16 (default: the compiled SIMD width)
+//!   --lanes N          rays per packet: 1, 4, 8 or 16 (default: the run-time SIMD level's)
 //!   --threads N        worker threads (default: every core)
 //!   --ppm FILE         write one scene as a binary PPM instead (the firmware comparison)
 //!   --scene bunny-fw   (not among the six) the firmware `bvh`'s picture: the vendored bunny's
@@ -386,16 +386,11 @@ struct Options {
     obj: Option<PathBuf>,
 }
 
-/// The packet width the binary was compiled for: 16 with AVX-512, 8 with AVX, else 4 (SSE2,
-/// NEON). Every width gives the same image; this one is usually the fastest.
+/// The packet width of the SIMD level the queries run at (chosen when the program runs,
+/// `raylane::simd`): 16 with AVX-512, 8 with AVX2, else 4 (SSE2, NEON). Every width gives the
+/// same image; this one is usually the fastest.
 fn default_lanes() -> usize {
-    if cfg!(target_feature = "avx512f") {
-        16
-    } else if cfg!(target_feature = "avx") {
-        8
-    } else {
-        4
-    }
+    raylane::simd::level().lanes().max(4)
 }
 
 /// The scenes, in order.
@@ -480,8 +475,12 @@ fn main() -> ExitCode {
             return ExitCode::FAILURE;
         }
         println!(
-            "{} threads, {} rays per packet, tiles of {}x{}",
-            o.threads, o.lanes, TILE.0, TILE.1
+            "{} threads, SIMD level {} (chosen at run time), {} rays per packet, tiles of {}x{}",
+            o.threads,
+            raylane::simd::level(),
+            o.lanes,
+            TILE.0,
+            TILE.1
         );
     }
     for name in &o.scenes {

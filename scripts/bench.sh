@@ -11,10 +11,12 @@
 #                                   (a plain timed example, medians of a few runs; ~10 minutes)
 #
 # Installs what it needs on Debian (libembree-dev for Embree, valgrind, QEMU and the ARM
-# binutils for the counts). The timed benches are built for the machine they run on
-# (`-C target-cpu=native`, in target/bench-native, so the other builds keep their caches):
-# Embree picks its widest ISA at run time, and raylane gets the same chance. Each summary is
-# printed after criterion's report and kept in target/bench/*.md.
+# binutils for the counts). The timed benches are built as users build them, with no
+# `target-cpu` (in target/bench): raylane picks its SIMD level when it runs, as Embree picks
+# its ISA; the header of each summary names the level. `NATIVE=1 ./scripts/bench.sh ...`
+# builds for this machine's CPU instead (`-C target-cpu=native`, in target/bench-native), the
+# reference the default build is compared with. Each summary is printed after criterion's
+# report and kept in target/bench/*.md (*-native.md for NATIVE=1).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 root=$PWD
@@ -31,17 +33,20 @@ if [ ${#need[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
 fi
 
+flags=""; tdir="$root/target/bench"; suffix=""
+if [ -n "${NATIVE:-}" ]; then flags="-C target-cpu=native"; tdir="$root/target/bench-native"; suffix="-native"; fi
+
 timed() { # timed NAME ARGS...: one criterion bench, its summary kept in target/bench/NAME.md
   local name=$1; shift
-  RUSTFLAGS="-C target-cpu=native" cargo bench --quiet -p raylane-bench --target-dir "$root/target/bench-native" \
-    --bench "$name" "$@" | tee "$out/$name.log"
-  sed -n '/^## /,$p' "$out/$name.log" > "$out/$name.md"
+  RUSTFLAGS="$flags" cargo bench --quiet -p raylane-bench --target-dir "$tdir" \
+    --bench "$name" "$@" | tee "$out/$name$suffix.log"
+  sed -n '/^## /,$p' "$out/$name$suffix.log" > "$out/$name$suffix.md"
 }
 
 scenes() { # the BVH benchmark (benches/examples/scenes.rs), its tables kept in target/bench/scenes.md
-  RUSTFLAGS="-C target-cpu=native" cargo run --quiet --release -p raylane-bench --features peers \
-    --target-dir "$root/target/bench-native" --example scenes -- "$@" | tee "$out/scenes.log"
-  sed -n '/^## /,$p' "$out/scenes.log" > "$out/scenes.md"
+  RUSTFLAGS="$flags" cargo run --quiet --release -p raylane-bench --features peers \
+    --target-dir "$tdir" --example scenes -- "$@" | tee "$out/scenes$suffix.log"
+  sed -n '/^## /,$p' "$out/scenes$suffix.log" > "$out/scenes$suffix.md"
 }
 
 case $what in

@@ -3,7 +3,9 @@
 # counted exactly by valgrind's callgrind (which cannot decode AVX-512, hence x86-64-v3; Embree
 # picks its AVX2 kernels under it).
 #
-#   ./scripts/count-scenes.sh        prints the Markdown table (also kept in target/count/scenes.md)
+#   ./scripts/count-scenes.sh            prints the Markdown table (also kept in target/count/scenes.md)
+#   ./scripts/count-scenes.sh --default  the same for a default build (no target-cpu: what users
+#                                        ship), which valgrind runs at the AVX2 level (raylane::simd)
 #
 # The `count_scenes` example (benches/examples/count_scenes.rs) runs each frame (primary,
 # diffuse and shadow rays of the vendored bunny) as one call of an out-of-line function;
@@ -22,9 +24,11 @@ if [ "${#need[@]}" -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${need[@]}" >/dev/null
 fi
 
-RUSTFLAGS="-C target-cpu=x86-64-v3" cargo build --quiet --release -p raylane-bench --features peers \
-  --example count_scenes --target-dir "$root/target/count-x86-64-v3"
-bin="$root/target/count-x86-64-v3/release/examples/count_scenes"
+build=x86-64-v3; flags="-C target-cpu=x86-64-v3"; tdir=count-x86-64-v3
+if [ "${1:-}" = --default ]; then build=default; flags=""; tdir=count-default; fi
+RUSTFLAGS="$flags" cargo build --quiet --release -p raylane-bench --features peers \
+  --example count_scenes --target-dir "$root/target/$tdir"
+bin="$root/target/$tdir/release/examples/count_scenes"
 
 dir=$(mktemp -d "$out/callgrind.XXXXXX")
 trap 'rm -rf "$dir"' EXIT
@@ -37,7 +41,8 @@ while read -r line; do
   k=$((k + 1))
   n=$(awk '$1 == "totals:" { print $2 }' "$dir/cg.out.$k")
   echo "$line ${n:?no totals in dump $k}"
-done < "$dir/manifest.txt" > "$out/scenes.txt"
+done < "$dir/manifest.txt" > "$out/scenes-$build.txt"
 cpu=$(grep -m1 'model name' /proc/cpuinfo | cut -d: -f2 | sed 's/^ //')
-"$bin" table "$out/scenes.txt" "x86-64-v3 (AVX2; $cpu; valgrind $(valgrind --version | sed 's/valgrind-//'))" \
-  | tee "$out/scenes.md"
+what="x86-64-v3 build"; [ "$build" = default ] && what="default build at the AVX2 level"
+"$bin" table "$out/scenes-$build.txt" "$what ($cpu; valgrind $(valgrind --version | sed 's/valgrind-//'))" \
+  | tee "$out/scenes-$build.md"

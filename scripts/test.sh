@@ -11,8 +11,10 @@
 #    thumbv7em (M4F), thumbv8m.main (M33), riscv32imac and riscv32imafc, with no default
 #    features and with each feature.
 # 4. MSRV: the library built and its test suite run with the rust-version toolchain.
-# 5. The host test suite (x86-64 baseline), the checker over every vector file with every
-#    method at every lane width, and the baseline digests of every method and width.
+# 5. The host test suite (a default x86-64 build) at every SIMD level of the CPU, chosen at run
+#    time (raylane::simd; RAYLANE_SIMD forces the lower ones), the checker over every vector
+#    file with every method at every lane width, and the digests of every method and width at
+#    every level.
 # 6. The host suite again built for x86-64-v3 (AVX2, FMA) and for the native CPU (AVX-512
 #    here); their digests must equal the baseline.
 # 7. Instructions per ray–primitive test of every kernel through the library's query, on
@@ -98,8 +100,21 @@ cargo "+$msrv" test --quiet -p raylane --target-dir target/msrv \
 grep -E '^test result' target/msrv.log | sed "s/^/rust $msrv: /"
 echo "rust $msrv ($(rustc "+$msrv" --version)): the library builds with every feature and its tests pass"
 
-step "host test suite (x86-64)"
+step "host test suite (x86-64, a default build: every SIMD level this CPU has, chosen at run time)"
+# The SIMD levels of this CPU (raylane::simd): the suite runs once at the best (detected) and
+# again at each lower one (RAYLANE_SIMD), the same binary.
+flags=$(grep -m1 '^flags' /proc/cpuinfo || true)
+has() { for f in "$@"; do [[ " $flags " == *" $f "* ]] || return 1; done; }
+levels=(baseline)
+has avx2 fma bmi1 bmi2 movbe f16c && levels+=(avx2)
+has avx2 fma bmi1 bmi2 movbe f16c avx512f avx512bw avx512cd avx512dq avx512vl && levels+=(avx512)
+echo "SIMD levels of this CPU: ${levels[*]}"
 cargo test --quiet
+for lv in "${levels[@]:0:${#levels[@]}-1}"; do
+  echo "suite at RAYLANE_SIMD=$lv"
+  RAYLANE_SIMD=$lv cargo test --quiet --test suite 2>&1 | grep -E '^test result|FAILED|panicked' \
+    || fail "the suite fails at SIMD level $lv"
+done
 
 step "checker: every method, every lane width"
 cargo build --quiet --release --example check --example digest --example render
@@ -139,6 +154,12 @@ same() { # same NAME FILE [BASE]: FILE's digests equal BASE's (default: x86-64's
     fail "$1 digests differ from x86-64"
   fi
 }
+
+# The default build's digests at each lower SIMD level (the run above is at the best one).
+for lv in "${levels[@]:0:${#levels[@]}-1}"; do
+  RAYLANE_SIMD=$lv ./target/release/examples/digest | grep '^digest' > "target/digests/x86-64-$lv.txt"
+  same "x86-64 at SIMD level $lv" "target/digests/x86-64-$lv.txt"
+done
 
 for cpu in x86-64-v3 native; do
   step "host test suite, -C target-cpu=$cpu"

@@ -90,24 +90,6 @@ pub struct Hits<L: Lane> {
 }
 
 impl<L: Lane> Hits<L> {
-    /// The records a query made in the lanes it runs in ([`Lane::Run`]), in `L`'s.
-    #[inline(always)]
-    #[must_use]
-    pub fn from_run(h: Hits<L::Run>) -> Self {
-        let v = |v: V3<L::Run>| V3::new(L::from_run(v.x), L::from_run(v.y), L::from_run(v.z));
-        Hits {
-            t: L::from_run(h.t),
-            point: v(h.point),
-            normal: v(h.normal),
-            front: L::mask_from_run(h.front),
-            index: L::indices_from_run(h.index),
-            set: L::indices_from_run(h.set),
-            u: L::from_run(h.u),
-            v: L::from_run(h.v),
-            mask: L::mask_from_run(h.mask),
-        }
-    }
-
     /// No lane hits.
     #[inline]
     #[must_use]

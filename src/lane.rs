@@ -21,8 +21,12 @@ use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 use wide::{f32x4, f32x8, f32x16};
 
 mod portable;
+#[cfg(target_arch = "x86_64")]
+mod x86;
 
-pub use portable::{X8, X16};
+pub use portable::X8;
+#[cfg(target_arch = "x86_64")]
+pub(crate) use x86::{Y8, Y16, Z16};
 
 /// The element type of a lane: `f32` or `f64`.
 pub trait Scalar: Copy + Debug + PartialOrd + Default + 'static {
@@ -76,8 +80,18 @@ pub trait Mask:
     fn all(self) -> bool;
     /// Bit `i` is lane `i`.
     fn bits(self) -> u32;
-    /// Returns `self` with lane `i` set to `b`.
+    /// Returns `self` with lane `i` set to `b` (unchanged when there is no lane `i`).
     fn with_lane(self, i: usize, b: bool) -> Self;
+    /// The mask whose lane `i` is bit `i` of `bits` (bits past the lanes ignored).
+    #[inline(always)]
+    fn from_bits(mut bits: u32) -> Self {
+        let mut m = Self::splat(false);
+        while bits != 0 {
+            m = m.with_lane(bits.trailing_zeros() as usize, true);
+            bits &= bits - 1;
+        }
+        m
+    }
     /// True when no lane is set.
     #[inline(always)]
     fn none(self) -> bool {
@@ -210,11 +224,6 @@ pub trait Lane:
     /// of them may continue lane by lane through the one-ray traversal (the same answers).
     /// False for counting and higher-precision lanes, whose work stays in the lane type.
     const PLAIN_F32: bool = false;
-    /// The lane type a query runs a packet of these in (the same lanes, the same bits): on
-    /// x86-64 raylane's own [`X8`] and [`X16`] for `wide`'s 8 and 16 lanes, which the
-    /// [run-time level](crate::simd) compiles to its widest registers (`wide`'s keep the
-    /// representation of the build); `Self` for every other lane type and target.
-    type Run: Lane<Scalar = Self::Scalar>;
 
     /// The same value in every lane.
     fn splat(x: Self::Scalar) -> Self;
@@ -271,16 +280,6 @@ pub trait Lane:
     }
     /// Lane `i` as a single higher-precision lane (exact widening).
     fn precise_lane(self, i: usize) -> Self::Precise;
-    /// The same lanes as [`Run`](Self::Run).
-    fn into_run(self) -> Self::Run;
-    /// The same lanes from [`Run`](Self::Run).
-    fn from_run(x: Self::Run) -> Self;
-    /// A mask as [`Run`](Self::Run)'s.
-    fn mask_into_run(m: Self::Mask) -> <Self::Run as Lane>::Mask;
-    /// A mask from [`Run`](Self::Run)'s.
-    fn mask_from_run(m: <Self::Run as Lane>::Mask) -> Self::Mask;
-    /// Indices from [`Run`](Self::Run)'s.
-    fn indices_from_run(i: <Self::Run as Lane>::Indices) -> Self::Indices;
 
     /// Builds a lane value from `f32` elements (exact).
     #[inline(always)]
@@ -404,7 +403,6 @@ fn finite_f32(x: f32) -> bool {
 
 impl Lane for f32 {
     const PLAIN_F32: bool = true;
-    type Run = f32;
     type Scalar = f32;
     type Mask = bool;
     type Precise = f64;
@@ -474,30 +472,9 @@ impl Lane for f32 {
     fn precise_lane(self, _i: usize) -> f64 {
         self as f64
     }
-    #[inline(always)]
-    fn into_run(self) -> Self {
-        self
-    }
-    #[inline(always)]
-    fn from_run(x: Self) -> Self {
-        x
-    }
-    #[inline(always)]
-    fn mask_into_run(m: bool) -> bool {
-        m
-    }
-    #[inline(always)]
-    fn mask_from_run(m: bool) -> bool {
-        m
-    }
-    #[inline(always)]
-    fn indices_from_run(i: [u32; 1]) -> [u32; 1] {
-        i
-    }
 }
 
 impl Lane for f64 {
-    type Run = f64;
     type Scalar = f64;
     type Mask = bool;
     type Precise = f64;
@@ -556,32 +533,12 @@ impl Lane for f64 {
     fn precise_lane(self, _i: usize) -> f64 {
         self
     }
-    #[inline(always)]
-    fn into_run(self) -> Self {
-        self
-    }
-    #[inline(always)]
-    fn from_run(x: Self) -> Self {
-        x
-    }
-    #[inline(always)]
-    fn mask_into_run(m: bool) -> bool {
-        m
-    }
-    #[inline(always)]
-    fn mask_from_run(m: bool) -> bool {
-        m
-    }
-    #[inline(always)]
-    fn indices_from_run(i: [u32; 1]) -> [u32; 1] {
-        i
-    }
 }
 
 /// Implements [`Mask`] and [`Lane`] for a `wide` f32 vector type: one macro, so the widths
 /// cannot drift apart.
 macro_rules! wide_lane {
-    ($t:ident, $n:literal, $max:ident, $run:ty) => {
+    ($t:ident, $n:literal, $max:ident) => {
         impl Mask for $t {
             #[inline(always)]
             fn splat(b: bool) -> Self {
@@ -602,7 +559,9 @@ macro_rules! wide_lane {
             #[inline(always)]
             fn with_lane(self, i: usize, b: bool) -> Self {
                 let mut a = self.to_array();
-                a[i] = f32::from_bits(if b { u32::MAX } else { 0 });
+                if let Some(x) = a.get_mut(i) {
+                    *x = f32::from_bits(if b { u32::MAX } else { 0 });
+                }
                 $t::new(a)
             }
         }
@@ -612,7 +571,6 @@ macro_rules! wide_lane {
             type Mask = $t;
             type Precise = f64;
             type Indices = [u32; $n];
-            type Run = $run;
             const LANES: usize = $n;
             const PLAIN_F32: bool = true;
 
@@ -716,26 +674,6 @@ macro_rules! wide_lane {
             fn max_lane(self) -> f32 {
                 $max(self)
             }
-            #[inline(always)]
-            fn into_run(self) -> $run {
-                bytemuck::cast(self)
-            }
-            #[inline(always)]
-            fn from_run(x: $run) -> Self {
-                bytemuck::cast(x)
-            }
-            #[inline(always)]
-            fn mask_into_run(m: Self) -> $run {
-                bytemuck::cast(m)
-            }
-            #[inline(always)]
-            fn mask_from_run(m: $run) -> Self {
-                bytemuck::cast(m)
-            }
-            #[inline(always)]
-            fn indices_from_run(i: [u32; $n]) -> [u32; $n] {
-                i
-            }
         }
     };
 }
@@ -771,15 +709,9 @@ fn max16(v: f32x16) -> f32 {
     max8(hi.simd_gt(lo).select(hi, lo))
 }
 
-wide_lane!(f32x4, 4, max4, f32x4);
-#[cfg(target_arch = "x86_64")]
-wide_lane!(f32x8, 8, max8, X8);
-#[cfg(target_arch = "x86_64")]
-wide_lane!(f32x16, 16, max16, X16);
-#[cfg(not(target_arch = "x86_64"))]
-wide_lane!(f32x8, 8, max8, f32x8);
-#[cfg(not(target_arch = "x86_64"))]
-wide_lane!(f32x16, 16, max16, f32x16);
+wide_lane!(f32x4, 4, max4);
+wide_lane!(f32x8, 8, max8);
+wide_lane!(f32x16, 16, max16);
 
 #[cfg(test)]
 mod tests {

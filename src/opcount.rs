@@ -215,8 +215,6 @@ impl<L: Lane> Lane for Counted<L> {
     type Mask = L::Mask;
     type Precise = Counted<L::Precise>;
     type Indices = L::Indices;
-    /// Counting is never dispatched: a counted query runs the counted lanes themselves.
-    type Run = Self;
     const LANES: usize = L::LANES;
 
     #[inline]
@@ -279,26 +277,6 @@ impl<L: Lane> Lane for Counted<L> {
     #[inline]
     fn precise_lane(self, i: usize) -> Self::Precise {
         Counted(self.0.precise_lane(i))
-    }
-    #[inline]
-    fn into_run(self) -> Self {
-        self
-    }
-    #[inline]
-    fn from_run(x: Self) -> Self {
-        x
-    }
-    #[inline]
-    fn mask_into_run(m: Self::Mask) -> Self::Mask {
-        m
-    }
-    #[inline]
-    fn mask_from_run(m: Self::Mask) -> Self::Mask {
-        m
-    }
-    #[inline]
-    fn indices_from_run(i: Self::Indices) -> Self::Indices {
-        i
     }
 }
 

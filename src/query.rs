@@ -65,10 +65,11 @@
 use crate::camera::{Tile, block_lane};
 use crate::hit::{All, Any, Closest, Hit, Hits};
 use crate::kernel::{Cull, Kernel};
-use crate::lane::{Lane, Mask};
+use crate::lane::{Lane, Mask, Scalar};
 use crate::ray::{Ray, RayPacket};
 use crate::set::{Set, Trace, Using};
 use crate::simd;
+use crate::vec3::V3;
 
 /// The one query vocabulary (see the [module docs](self)): closest hit, occlusion and every
 /// hit, for a ray or a packet, over any set. Every lane of a packet answer equals the one-ray
@@ -208,8 +209,48 @@ fn any_packet<T: Trace + ?Sized, L: Lane>(t: &T, rays: &RayPacket<L>) -> L::Mask
     c.finish()
 }
 
-/// Packets run in [`Lane::Run`]'s lanes (raylane's own vectors for `wide`'s 8 and 16 on
-/// x86-64), at the [level](crate::simd) chosen when the program runs: the same bits.
+/// The rays of a packet in `M`'s lanes (the same values).
+#[cfg_attr(target_arch = "x86_64", inline(always))]
+fn packet_in<L: Lane, M: Lane<Scalar = f32>>(r: &RayPacket<L>) -> RayPacket<M> {
+    let c = |x: L| M::from_fn(|i| x.lane(i).to_f64() as f32);
+    let v = |v: V3<L>| V3::new(c(v.x), c(v.y), c(v.z));
+    RayPacket {
+        origin: v(r.origin),
+        dir: v(r.dir),
+        t_min: c(r.t_min),
+        t_max: c(r.t_max),
+    }
+}
+
+/// A packet's records from `M`'s lanes in `L`'s (the same values).
+#[cfg_attr(target_arch = "x86_64", inline(always))]
+fn hits_out<L: Lane, M: Lane<Scalar = f32>>(h: &Hits<M>) -> Hits<L> {
+    let c = |x: M| L::from_fn(|i| L::Scalar::from_f32(x.lane(i)));
+    let v = |v: V3<M>| V3::new(c(v.x), c(v.y), c(v.z));
+    let ids = |x: &M::Indices| {
+        let mut out = L::indices(u32::MAX);
+        for (o, i) in out.as_mut().iter_mut().zip(x.as_ref()) {
+            *o = *i;
+        }
+        out
+    };
+    Hits {
+        t: c(h.t),
+        point: v(h.point),
+        normal: v(h.normal),
+        front: L::Mask::from_bits(h.front.bits()),
+        index: ids(&h.index),
+        set: ids(&h.set),
+        u: c(h.u),
+        v: c(h.v),
+        mask: L::Mask::from_bits(h.mask.bits()),
+    }
+}
+
+/// Packets of plain `f32` lanes run at the [level](crate::simd) chosen when the program runs,
+/// in its vectors ([`simd::with_lanes`]: raylane's own AVX and AVX-512 types for 8 and 16
+/// lanes on x86-64), converted in and out bit for bit; other lane types (counting, `f64`) run
+/// as they are.
 impl<L: Lane> Rays for RayPacket<L> {
     type Closest = Hits<L>;
     type Any = L::Mask;
@@ -217,36 +258,66 @@ impl<L: Lane> Rays for RayPacket<L> {
 
     #[inline]
     fn closest<T: Trace + ?Sized>(t: &T, rays: &Self) -> Hits<L> {
-        let r = rays.into_run();
-        Hits::from_run(simd::run(
+        struct Q<'a, T: ?Sized, L: Lane>(&'a T, &'a RayPacket<L>);
+        impl<T: Trace + ?Sized, L: Lane> simd::Packets for Q<'_, T, L> {
+            type Output = Hits<L>;
             #[inline(always)]
-            || closest_packet(t, &r),
-        ))
+            fn run<M: Lane<Scalar = f32>>(self) -> Hits<L> {
+                hits_out(&closest_packet(self.0, &packet_in::<L, M>(self.1)))
+            }
+        }
+        if L::PLAIN_F32 {
+            simd::with_lanes(L::LANES, Q(t, rays))
+        } else {
+            closest_packet(t, rays)
+        }
     }
 
     #[inline]
     fn any<T: Trace + ?Sized>(t: &T, rays: &Self) -> L::Mask {
-        let r = rays.into_run();
-        L::mask_from_run(simd::run(
+        struct Q<'a, T: ?Sized, L: Lane>(&'a T, &'a RayPacket<L>);
+        impl<T: Trace + ?Sized, L: Lane> simd::Packets for Q<'_, T, L> {
+            type Output = L::Mask;
             #[inline(always)]
-            || any_packet(t, &r),
-        ))
+            fn run<M: Lane<Scalar = f32>>(self) -> L::Mask {
+                L::Mask::from_bits(any_packet(self.0, &packet_in::<L, M>(self.1)).bits())
+            }
+        }
+        if L::PLAIN_F32 {
+            simd::with_lanes(L::LANES, Q(t, rays))
+        } else {
+            any_packet(t, rays)
+        }
     }
 
     #[inline]
     fn all<T: Trace + ?Sized>(t: &T, rays: &Self, f: &mut dyn FnMut(Hits<L>)) {
-        let r = rays.into_run();
-        simd::run(
+        struct Q<'a, 'f, T: ?Sized, L: Lane>(
+            &'a T,
+            &'a RayPacket<L>,
+            &'a mut dyn FnMut(Hits<L>),
+            core::marker::PhantomData<&'f ()>,
+        );
+        impl<T: Trace + ?Sized, L: Lane> simd::Packets for Q<'_, '_, T, L> {
+            type Output = ();
             #[inline(always)]
-            || {
-                let mut c = All::new(&r, |h: &Hits<L::Run>| f(Hits::from_run(*h)));
-                t.trace(&r, 0, &mut c);
-            },
-        )
+            fn run<M: Lane<Scalar = f32>>(self) {
+                let f = self.2;
+                let r = packet_in::<L, M>(self.1);
+                let mut c = All::new(&r, |h: &Hits<M>| f(hits_out(h)));
+                self.0.trace(&r, 0, &mut c);
+            }
+        }
+        if L::PLAIN_F32 {
+            simd::with_lanes(L::LANES, Q(t, rays, f, core::marker::PhantomData))
+        } else {
+            let mut c = All::new(rays, |h: &Hits<L>| f(*h));
+            t.trace(rays, 0, &mut c);
+        }
     }
 }
 
-/// A tile enters the [level](crate::simd) once, its packets in [`Lane::Run`]'s lanes.
+/// A tile enters the [level](crate::simd) once, its packets in the level's vectors.
 impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L, W, H> {
     type Closest = [[Option<Hit>; W]; H];
     type Any = [[bool; W]; H];
@@ -255,49 +326,74 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
 
     #[inline]
     fn closest<T: Trace + ?Sized>(t: &T, tile: &Self) -> [[Option<Hit>; W]; H] {
-        simd::run(
+        struct Q<'a, 't, T: ?Sized, L: Lane, const W: usize, const H: usize>(
+            &'a T,
+            &'a Tile<'t, L, W, H>,
+        );
+        impl<T: Trace + ?Sized, L: Lane<Scalar = f32>, const W: usize, const H: usize> simd::Packets
+            for Q<'_, '_, T, L, W, H>
+        {
+            type Output = [[Option<Hit>; W]; H];
             #[inline(always)]
-            || {
+            fn run<M: Lane<Scalar = f32>>(self) -> Self::Output {
                 let mut out = [[None; W]; H];
-                for (dx, dy, rays) in tile.packets() {
-                    let hits = closest_packet(t, &rays.into_run());
+                for (dx, dy, rays) in self.1.packets() {
+                    let hits = closest_packet(self.0, &packet_in::<L, M>(&rays));
                     for i in 0..L::LANES {
                         let (px, py) = block_lane::<L>(i);
                         out[dy + py][dx + px] = hits.lane(i);
                     }
                 }
                 out
-            },
-        )
+            }
+        }
+        simd::with_lanes(L::LANES, Q(t, tile))
     }
 
     #[inline]
     fn any<T: Trace + ?Sized>(t: &T, tile: &Self) -> [[bool; W]; H] {
-        simd::run(
+        struct Q<'a, 't, T: ?Sized, L: Lane, const W: usize, const H: usize>(
+            &'a T,
+            &'a Tile<'t, L, W, H>,
+        );
+        impl<T: Trace + ?Sized, L: Lane<Scalar = f32>, const W: usize, const H: usize> simd::Packets
+            for Q<'_, '_, T, L, W, H>
+        {
+            type Output = [[bool; W]; H];
             #[inline(always)]
-            || {
+            fn run<M: Lane<Scalar = f32>>(self) -> Self::Output {
                 let mut out = [[false; W]; H];
-                for (dx, dy, rays) in tile.packets() {
-                    let hit = any_packet(t, &rays.into_run());
+                for (dx, dy, rays) in self.1.packets() {
+                    let hit = any_packet(self.0, &packet_in::<L, M>(&rays));
                     for i in 0..L::LANES {
                         let (px, py) = block_lane::<L>(i);
                         out[dy + py][dx + px] = hit.test(i);
                     }
                 }
                 out
-            },
-        )
+            }
+        }
+        simd::with_lanes(L::LANES, Q(t, tile))
     }
 
     #[inline]
     fn all<T: Trace + ?Sized>(t: &T, tile: &Self, f: &mut dyn FnMut((u32, u32, Hit))) {
-        let (x, y) = tile.origin();
-        simd::run(
+        struct Q<'a, 't, T: ?Sized, L: Lane, const W: usize, const H: usize>(
+            &'a T,
+            &'a Tile<'t, L, W, H>,
+            &'a mut dyn FnMut((u32, u32, Hit)),
+        );
+        impl<T: Trace + ?Sized, L: Lane<Scalar = f32>, const W: usize, const H: usize> simd::Packets
+            for Q<'_, '_, T, L, W, H>
+        {
+            type Output = ();
             #[inline(always)]
-            || {
-                for (dx, dy, rays) in tile.packets() {
-                    let r = rays.into_run();
-                    let mut c = All::new(&r, |h: &Hits<L::Run>| {
+            fn run<M: Lane<Scalar = f32>>(self) {
+                let (x, y) = self.1.origin();
+                let f = self.2;
+                for (dx, dy, rays) in self.1.packets() {
+                    let r = packet_in::<L, M>(&rays);
+                    let mut c = All::new(&r, |h: &Hits<M>| {
                         for i in 0..L::LANES {
                             if let Some(hit) = h.lane(i) {
                                 let (px, py) = block_lane::<L>(i);
@@ -305,9 +401,10 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
                             }
                         }
                     });
-                    t.trace(&r, 0, &mut c);
+                    self.0.trace(&r, 0, &mut c);
                 }
-            },
-        )
+            }
+        }
+        simd::with_lanes(L::LANES, Q(t, tile, f))
     }
 }

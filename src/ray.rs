@@ -198,19 +198,6 @@ impl<L: Lane> RayPacket<L> {
         }
     }
 
-    /// The same rays in the lanes a query runs them in ([`Lane::Run`]).
-    #[inline(always)]
-    #[must_use]
-    pub fn into_run(&self) -> RayPacket<L::Run> {
-        let v = |v: V3<L>| V3::new(v.x.into_run(), v.y.into_run(), v.z.into_run());
-        RayPacket {
-            origin: v(self.origin),
-            dir: v(self.dir),
-            t_min: self.t_min.into_run(),
-            t_max: self.t_max.into_run(),
-        }
-    }
-
     /// The same ray in every lane.
     #[inline]
     #[must_use]

@@ -13,12 +13,13 @@
 //!
 //! The level is detected once (`cpuid`, and `xgetbv` for the OS's saving of the vector
 //! registers; no `std` needed) and chosen at the query's entry, never per node or kernel.
-//! Below the entry nothing knows about levels: the code is the crate's one generic body, its
-//! 8- and 16-lane vectors raylane's own ([`X8`](crate::lane::X8),
-//! [`X16`](crate::lane::X16): arrays the compiler turns into the level's widest registers),
-//! and every operation a correctly rounded IEEE operation with no fused multiply-add. **Every
-//! level gives the same bits**; only a BVH's box test, which only prunes, may differ in which
-//! boxes it opens (fused where the build itself targets FMA, see [`bvh`](crate::bvh)).
+//! Below the entry nothing knows about levels: the code is the crate's one generic body, with
+//! a packet's lanes in the level's vectors ([`with_lanes`]: at AVX2 one AVX register for 8
+//! lanes, two for 16; at AVX-512 one register for 16; `wide`'s at the baseline) and a BVH
+//! node's 8 children in [`X8`](crate::lane::X8), and every operation a correctly rounded IEEE
+//! operation with no fused multiply-add. **Every level gives the same bits**; only a BVH's box
+//! test, which only prunes, may differ in which boxes it opens (fused where the build itself
+//! targets FMA, see [`bvh`](crate::bvh)).
 //!
 //! A build for the CPU (`-C target-cpu=native`) or for a level (`x86-64-v3`) already runs
 //! those instructions everywhere: the entry then calls the code directly. Other targets
@@ -40,6 +41,8 @@
 //! ```
 
 use core::sync::atomic::{AtomicU8, Ordering};
+
+use crate::lane::Lane;
 
 /// A SIMD level (see the [module docs](self)).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
@@ -204,9 +207,82 @@ pub fn run<R>(f: impl FnOnce() -> R) -> R {
     }
 }
 
+/// Code generic over the lane type of a packet: what [`with_lanes`] runs. Its
+/// [`run`](Self::run) gets the lanes of the chosen level for the width asked.
+pub trait Packets {
+    /// What it returns.
+    type Output;
+    /// Runs with packets in `L` (`L::LANES` the width asked).
+    fn run<L: Lane<Scalar = f32>>(self) -> Self::Output;
+}
+
+/// Runs `f` compiled for the chosen [`level`], with packets of `lanes` lanes (1, 4, 8 or 16;
+/// any other width runs 16) in that level's vectors: on x86-64 at [`Level::Avx2`] raylane's own
+/// AVX types for 8 and 16 lanes (one and two registers), at [`Level::Avx512`] one AVX-512
+/// register for 16 (and AVX for 8); `wide`'s vectors at the baseline and for 4 lanes; `f32`
+/// for 1. The queries enter here: a packet of `wide::f32x8` is converted in and its records
+/// out, bit for bit.
+///
+/// The level's own types exist only on a CPU that has the level: code outside the crate meets
+/// them only as `run`'s type parameter (they have no name there). `f`'s `run` should be
+/// `#[inline(always)]` down to its loops, like the crate's query paths (see [`run`]).
+#[inline(always)]
+pub fn with_lanes<F: Packets>(lanes: usize, f: F) -> F::Output {
+    #[cfg(target_arch = "x86_64")]
+    {
+        x86::with_lanes(level(), lanes, f)
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        match lanes {
+            1 => f.run::<f32>(),
+            4 => f.run::<wide::f32x4>(),
+            8 => f.run::<wide::f32x8>(),
+            _ => f.run::<wide::f32x16>(),
+        }
+    }
+}
+
 #[cfg(target_arch = "x86_64")]
 mod x86 {
-    use super::Level;
+    use super::{Level, Packets};
+    use crate::lane::{Y8, Y16, Z16};
+
+    /// [`super::with_lanes`] at `level`.
+    #[inline(always)]
+    pub(super) fn with_lanes<F: Packets>(level: Level, lanes: usize, f: F) -> F::Output {
+        match (level, lanes) {
+            (_, 1) => run(
+                level,
+                #[inline(always)]
+                || f.run::<f32>(),
+            ),
+            (_, 4) => run(
+                level,
+                #[inline(always)]
+                || f.run::<wide::f32x4>(),
+            ),
+            (Level::Baseline, 8) => f.run::<wide::f32x8>(),
+            (Level::Baseline, _) => f.run::<wide::f32x16>(),
+            // Avx2 and Avx512 only where `best()` found them (`force` refuses more): the AVX
+            // types' instructions exist on this CPU.
+            (_, 8) => run(
+                level,
+                #[inline(always)]
+                || f.run::<Y8>(),
+            ),
+            (Level::Avx2, _) => run(
+                level,
+                #[inline(always)]
+                || f.run::<Y16>(),
+            ),
+            (Level::Avx512, _) => run(
+                level,
+                #[inline(always)]
+                || f.run::<Z16>(),
+            ),
+        }
+    }
 
     /// True when the build itself targets AVX-512 (or only AVX2): no run-time copies needed.
     const BUILT_V4: bool = cfg!(all(

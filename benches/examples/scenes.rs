@@ -3,7 +3,7 @@
 //! raylane's fastest contenders again on every core, in a table of their own).
 //!
 //! ```text
-//! RUSTFLAGS="-C target-cpu=native" cargo run --release -p raylane-bench --features peers \
+//! cargo run --release -p raylane-bench --features peers \
 //!     --example scenes [-- --runs N] [--only NAME]...      (or: ./scripts/bench.sh scenes)
 //! ```
 //!

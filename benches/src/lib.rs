@@ -773,13 +773,17 @@ pub fn cpu() -> String {
         .unwrap_or("sse2");
     let cores = info.lines().filter(|l| l.starts_with("processor")).count();
     let compiled = if cfg!(target_feature = "avx512f") {
-        "AVX-512"
+        "AVX-512 (target-cpu)"
     } else if cfg!(target_feature = "avx2") {
-        "AVX2"
+        "AVX2 (target-cpu)"
     } else {
-        "SSE2"
+        "the baseline (a default build)"
     };
-    format!("{model}, {cores} cores, up to {simd}; raylane compiled for {compiled}")
+    format!(
+        "{model}, {cores} cores, up to {simd}; raylane compiled for {compiled}, queries at the \
+         SIMD level {} (chosen at run time)",
+        raylane::simd::level()
+    )
 }
 
 /// The digest of a frame's rays and primitives (the firmware computes the same).

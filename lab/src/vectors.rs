@@ -528,17 +528,17 @@ pub fn evaluate(method: Method, lanes: usize, cases: &[Case], out: &mut [Outcome
     if ![1, 4, 8, 16].contains(&lanes) {
         return false;
     }
-    // At the run-time SIMD level, in the lanes queries run in (raylane::simd, Lane::Run): the
-    // digests of a default x86-64 build then cover every level (RAYLANE_SIMD).
-    raylane::simd::run(
-        #[inline(always)]
-        || match lanes {
-            1 => run::<f32>(method, cases, out),
-            4 => run::<<wide::f32x4 as Lane>::Run>(method, cases, out),
-            8 => run::<<wide::f32x8 as Lane>::Run>(method, cases, out),
-            _ => run::<<wide::f32x16 as Lane>::Run>(method, cases, out),
-        },
-    );
+    // At the run-time SIMD level, in its lanes (raylane::simd::with_lanes): the digests of a
+    // default x86-64 build then cover every level (RAYLANE_SIMD).
+    struct Run<'a>(Method, &'a [Case], &'a mut [Outcome]);
+    impl raylane::simd::Packets for Run<'_> {
+        type Output = ();
+        #[cfg_attr(target_arch = "x86_64", inline(always))]
+        fn run<L: Lane<Scalar = f32>>(self) {
+            run::<L>(self.0, self.1, self.2)
+        }
+    }
+    raylane::simd::with_lanes(lanes, Run(method, cases, out));
     true
 }
 

@@ -519,26 +519,34 @@ impl Baked<'_> {
             // tests and more stack: one triangle at a time, the same bits.
             let r1 = RayPacket::<f32>::splat(ray);
             let mut pre = None;
-            return traverse::one(self.nodes, self.reach, ray, start, c, |r_leaf, c| {
-                let (first, count) = Self::leaf(r_leaf);
-                let pre = pre.get_or_insert_with(|| K::prepare(&r1));
-                for t in first..first + count {
-                    let r = r1.shrink(true, c.t_max());
-                    let tri = TrianglePacket::splat(&self.triangle(t));
-                    let Some(h) = K::first(&r, pre, &tri, cull) else {
-                        continue;
-                    };
-                    let at = At {
-                        set,
-                        index: self.id(t),
-                        loc: t as u32,
-                    };
-                    if h.mask && c.offer(&h, at, |_| Hits::miss()) {
-                        return true;
+            return traverse::one(
+                self.nodes,
+                self.reach,
+                ray,
+                start,
+                c,
+                #[cfg_attr(target_arch = "x86_64", inline(always))]
+                |r_leaf, c| {
+                    let (first, count) = Self::leaf(r_leaf);
+                    let pre = pre.get_or_insert_with(|| K::prepare(&r1));
+                    for t in first..first + count {
+                        let r = r1.shrink(true, c.t_max());
+                        let tri = TrianglePacket::splat(&self.triangle(t));
+                        let Some(h) = K::first(&r, pre, &tri, cull) else {
+                            continue;
+                        };
+                        let at = At {
+                            set,
+                            index: self.id(t),
+                            loc: t as u32,
+                        };
+                        if h.mask && c.offer(&h, at, |_| Hits::miss()) {
+                            return true;
+                        }
                     }
-                }
-                false
-            });
+                    false
+                },
+            );
         }
         let r4 = RayPacket::<f32x4>::splat(ray).shrink(Mask::splat(true), f32x4::splat(c.t_max()));
         let mut pre = None;
@@ -609,6 +617,7 @@ impl Set for Baked<'_> {
             self.reach,
             &rays,
             c,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
             |r_leaf, r, cone, c| {
                 let (first, count) = Self::leaf(r_leaf);
                 // The triangles whose boxes the packet's cone may enter (as `leaf_many`).
@@ -642,6 +651,7 @@ impl Set for Baked<'_> {
                 false
             },
             split::<L, C>(),
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
             |start, i, c| {
                 alone(c, i, |one| {
                     self.trace_from::<K, _>(cull, &rays.lane_ray(i), start, set, one)

@@ -665,10 +665,12 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
             self.reach,
             &rays,
             c,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
             |li, r, cone, c| {
                 leaf_many::<P, K, L, C>(self.leaves, li, &rays, r, cone, &pre, cull, set, c)
             },
             split::<L, C>(),
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
             |start, i, c| {
                 alone(c, i, |one| {
                     self.trace_from::<K, _>(cull, &rays.lane_ray(i), start, set, one)

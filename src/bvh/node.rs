@@ -712,6 +712,7 @@ pub struct Frustum {
 impl Frustum {
     /// The intervals of the `valid` lanes of `s`, or `None` when their directions' signs
     /// differ on some axis or a lane visits every child.
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub(crate) fn new<L: Lane>(s: &PacketSlab<L>, valid: L::Mask) -> Option<Frustum> {
         if (s.all & valid).any() || valid.none() {
             return None;

@@ -325,6 +325,7 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
             self.top.reach,
             rays,
             c,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
             |li, r, _, c| {
                 let Some(leaf) = self.top.leaves.get(li as usize) else {
                     return false;
@@ -355,21 +356,29 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         if C::EVERY {
             return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
         }
-        traverse::one(self.top.nodes, self.top.reach, ray, 0, c, |li, c| {
-            let Some(leaf) = self.top.leaves.get(li as usize) else {
-                return false;
-            };
-            for &i in leaf.indices() {
-                let Some((inst, object)) = self.placed(i) else {
-                    continue;
+        traverse::one(
+            self.top.nodes,
+            self.top.reach,
+            ray,
+            0,
+            c,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |li, c| {
+                let Some(leaf) = self.top.leaves.get(li as usize) else {
+                    return false;
                 };
-                let local = inst.ray_to_object(ray);
-                if object.trace_ray_with::<K, C>(cull, &local, set + i, c) {
-                    return true;
+                for &i in leaf.indices() {
+                    let Some((inst, object)) = self.placed(i) else {
+                        continue;
+                    };
+                    let local = inst.ray_to_object(ray);
+                    if object.trace_ray_with::<K, C>(cull, &local, set + i, c) {
+                        return true;
+                    }
                 }
-            }
-            false
-        })
+                false
+            },
+        )
     }
 
     fn records_with<L: Lane>(

@@ -1,17 +1,17 @@
-//! raylane's own 8- and 16-lane `f32` vectors, [`X8`] and [`X16`]: plain arrays whose
-//! element-wise operations the compiler turns into the widest registers of the code they are
-//! inlined into. Inside a query entered at [`simd::Level::Avx2`](crate::simd::Level) an `X8`
-//! operation is one AVX instruction, where `wide::f32x8`, whose representation `wide` chose
-//! when it was compiled (SSE2 in a default x86-64 build), stays two SSE halves; at
-//! [`Avx512`](crate::simd::Level::Avx512) an `X16` is one register. On x86-64 the queries run
-//! packets of 8 and 16 lanes in them ([`Lane::Run`]), and the BVH's one-ray node test in
-//! `X8`.
+//! [`X8`]: eight `f32` lanes as a plain array, whose element-wise operations the compiler turns
+//! into the widest registers of the code they are inlined into. The BVH's one-ray node test
+//! runs a node's 8 children in it on x86-64: inside a query entered at
+//! [`simd::Level::Avx2`](crate::simd::Level) it is one AVX register, where `wide::f32x8`,
+//! whose representation `wide` chose when it was compiled (SSE2 in a default x86-64 build),
+//! stays two SSE halves. (Packets, whose kernels are larger, run in the levels' own vector
+//! types instead: element-wise code there was not always vectorized, see
+//! [`simd`](crate::simd).)
 //!
 //! Every operation is the IEEE operation of each lane (no fused multiply-add, no
 //! approximation): the same bits as `wide`'s vectors and the scalar path. The few operations
 //! a compiler does not find from element-wise code use the baseline's 4-lane instructions
-//! (SSE2 or NEON) on each quarter or half, which it merges where the level is wider: the
-//! square root, and the sign-bit masks ([`Mask::bits`], [`Mask::any`]).
+//! (SSE2 or NEON) on each half, which it merges where the level is wider: the square root,
+//! and the sign-bit masks ([`Mask::bits`], [`Mask::any`]).
 
 use core::ops::{Add, BitAnd, BitOr, Div, Mul, Neg, Not, Sub};
 
@@ -240,7 +240,6 @@ macro_rules! portable {
             type Mask = $t;
             type Precise = f64;
             type Indices = [u32; $n];
-            type Run = $t;
             const LANES: usize = $n;
             const PLAIN_F32: bool = true;
 
@@ -334,26 +333,6 @@ macro_rules! portable {
                 }
                 v[0]
             }
-            #[inline(always)]
-            fn into_run(self) -> Self {
-                self
-            }
-            #[inline(always)]
-            fn from_run(x: Self) -> Self {
-                x
-            }
-            #[inline(always)]
-            fn mask_into_run(m: Self) -> Self {
-                m
-            }
-            #[inline(always)]
-            fn mask_from_run(m: Self) -> Self {
-                m
-            }
-            #[inline(always)]
-            fn indices_from_run(i: [u32; $n]) -> [u32; $n] {
-                i
-            }
         }
     };
 }
@@ -363,12 +342,6 @@ portable!(
     X8,
     8,
     32
-);
-portable!(
-    /// Sixteen `f32` lanes (see the [module docs](self)).
-    X16,
-    16,
-    64
 );
 
 /// All ones (a true lane) or all zeros.

@@ -24,7 +24,7 @@ use crate::ray::RayPacket;
 /// let tri = Triangle::new(Vec3::ZERO, Vec3::new(4.0, 0.0, 0.0), Vec3::new(0.0, 3.0, 0.0));
 /// let rec = Wald::precompute(&TrianglePacket::<f32>::splat(&tri)); // once per triangle
 /// let ray = raylane::Ray::new(Vec3::new(1.0, 1.0, 5.0), Vec3::new(0.0, 0.0, -1.0));
-/// let hit = Wald::test(&RayPacket::<f32>::splat(&ray), &rec, Cull::None).normalized();
+/// let hit = Wald::test(&RayPacket::<f32>::splat(&ray), &rec, Cull::None).unwrap().normalized();
 /// assert_eq!((hit.t, hit.u, hit.v), (5.0, 0.25, 1.0 / 3.0));
 /// ```
 pub trait PrecomputedKernel {
