@@ -353,7 +353,7 @@ impl Trace for FocalSpheres<'_> {
                         Sphere::records(rays, w, cull, |_| self.spheres.get(i).copied())
                     };
                     let roots = Focal::maybe_roots(r, &Splat(e))?;
-                    if C::EVERY {
+                    if C::EACH {
                         Some(each_root(&roots, cull, |h| c.offer(h, at, record)))
                     } else {
                         let h = first_root(&roots, cull);

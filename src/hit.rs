@@ -22,6 +22,15 @@
 //!   reach the collector and everything farther is cut.
 //! * **Stopping.** [`Any`] stops a traversal once every lane has hit; [`All`] reports every
 //!   hit, in the order the set visits them.
+//! * **Layers and filters.** A query may carry, per ray lane, a 32-bit layer mask and a set
+//!   to ignore ([`Visibility`]), and a filter ([`Filter`]) that may reject any candidate
+//!   ([`Candidate`]: its set, primitive, `t`, `u`, `v`, lane). They live here, in a collector
+//!   wrapper ([`Screen`]) that every set traces into like any other collector: a set of
+//!   instances asks it which lanes see an instance ([`Collector::sees`]), and every
+//!   candidate passes the ignored set and the filter before the interval and tie rules see
+//!   it. A rejected candidate is as if it did not exist, so the answers are brute force's
+//!   with the same masks, ignored sets and filter, bit for bit. Queries without any of them
+//!   never build a `Screen`: their code is the same as before.
 //!
 //! **Records.** The collectors keep only `t`, the barycentrics, the indices and where the
 //! winner sits; the point `o + t·d` (3 mul, 3 add), the unit geometric normal and the face
@@ -36,7 +45,7 @@
 use glam::Vec3;
 
 use crate::kernel::{Cull, LaneHit, Primitive, plus_zero};
-use crate::lane::{Lane, Mask, Scalar, pow2};
+use crate::lane::{Lane, MAX_LANES, Mask, Scalar, pow2};
 use crate::plane::Plane;
 use crate::ray::RayPacket;
 use crate::sphere::Sphere;
@@ -260,6 +269,10 @@ pub trait Collector<L: Lane> {
     /// True when every hit is wanted (a sphere's exit roots too), not only the first per
     /// primitive; such a traversal cannot be restarted.
     const EVERY: bool = false;
+    /// True when every hit of a primitive must be offered (a sphere's exit roots too), even by
+    /// a traversal that may restart and prune ([`Screen`] with a filter: a rejected entry
+    /// root must leave the exit root its chance). By default [`EVERY`](Self::EVERY).
+    const EACH: bool = Self::EVERY;
     /// True when [`t_max`](Self::t_max) shrinks as hits are found (a traversal then prunes by
     /// it); false when it stays the relaxed upper end of the rays.
     const SHRINKS: bool = false;
@@ -267,6 +280,15 @@ pub trait Collector<L: Lane> {
     fn active(&self) -> L::Mask;
     /// The upper end each lane's kernel test uses now (relaxed; see [`relax`]).
     fn t_max(&self) -> L;
+    /// The lanes that see set `set` (an instance) on the layers `mask`: their query mask
+    /// shares a bit with it and they do not ignore the set ([`Screen`], [`Visibility`]); a set
+    /// of instances traces the other lanes past it. By default every lane: a query without
+    /// masks sees everything, and the test folds away.
+    #[inline(always)]
+    fn sees(&self, set: u32, mask: u32) -> L::Mask {
+        let _ = (set, mask);
+        Mask::splat(true)
+    }
     /// Takes the candidates of `h` (its `mask`'s lanes) of the primitive at `at`;
     /// `record` makes the records of one candidate (for collectors that report every hit).
     /// Returns true when the traversal may stop.
@@ -510,6 +532,7 @@ impl<'c, L: Lane, C: Collector<L>> LaneOf<'c, L, C> {
 
 impl<L: Lane, C: Collector<L>> Collector<f32> for LaneOf<'_, L, C> {
     const SHRINKS: bool = C::SHRINKS;
+    const EACH: bool = C::EACH;
 
     #[inline(always)]
     fn active(&self) -> bool {
@@ -519,6 +542,11 @@ impl<L: Lane, C: Collector<L>> Collector<f32> for LaneOf<'_, L, C> {
     #[inline(always)]
     fn t_max(&self) -> f32 {
         self.t_max
+    }
+
+    #[inline(always)]
+    fn sees(&self, set: u32, mask: u32) -> bool {
+        self.c.sees(set, mask).test(self.i)
     }
 
     #[inline(always)]
@@ -592,6 +620,302 @@ impl<L: Lane, F: FnMut(&Hits<L>)> Collector<L> for All<L, F> {
             (self.f)(&record(&Winners::single(&one, at)));
         }
         false
+    }
+}
+
+/// A candidate hit as a query's [`Filter`] sees it: where it comes from and where it lies.
+/// The values are those the hit's record would carry, bit for bit, at every width.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Candidate {
+    /// The set ([`Hit::set`]: the instance of a scene, the position in a tuple).
+    pub set: u32,
+    /// The primitive's index in its set ([`Hit::index`]).
+    pub index: u32,
+    /// The ray parameter ([`Hit::t`]).
+    pub t: f32,
+    /// Triangles: the barycentric weight of vertex B ([`Hit::u`]). Spheres: 1 on an exit root
+    /// (the ray leaving the sphere: its back face), 0 on an entry root. Planes: 0.
+    pub u: f32,
+    /// Triangles: the barycentric weight of vertex C ([`Hit::v`]). Otherwise 0.
+    pub v: f32,
+    /// The ray's lane in its packet (0 for one ray; within a tile, the lane in its block):
+    /// for filters that differ per ray (each bullet ignores its own shooter).
+    pub lane: u32,
+}
+
+/// What a query asks of each candidate hit ([`Screen`]): keep it (`true`) or reject it. Any
+/// `Fn(&Candidate) -> bool` is one; [`Unfiltered`] keeps everything at no cost.
+///
+/// A filter must answer the same for the same candidate: it may be asked more than once about
+/// one (a traversal that restarts), and it is not asked about candidates that can no longer
+/// count (beyond the ray's interval or, for `closest`, beyond the closest hit kept so far).
+pub trait Filter {
+    /// True for [`Unfiltered`]: a query then skips the filter entirely, at compile time.
+    const NONE: bool = false;
+    /// Whether the candidate `c` counts.
+    fn keep(&self, c: &Candidate) -> bool;
+}
+
+impl<F: Fn(&Candidate) -> bool> Filter for F {
+    #[inline(always)]
+    fn keep(&self, c: &Candidate) -> bool {
+        self(c)
+    }
+}
+
+/// No filter: every candidate counts.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Unfiltered;
+
+impl Filter for Unfiltered {
+    const NONE: bool = true;
+    #[inline(always)]
+    fn keep(&self, _: &Candidate) -> bool {
+        true
+    }
+}
+
+/// What each ray lane of a query may see (a ray is lane 0): its 32-bit layer mask (an instance
+/// whose mask shares no bit with it is not seen; a mask of 0 sees nothing; sets that carry no
+/// masks count as carrying every bit), and one set it ignores (an instance, or a member of a
+/// tuple: "ignore self"), whose candidates do not count and which a scene does not even
+/// traverse for that lane.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Visibility {
+    masks: [u32; MAX_LANES],
+    /// The ignored set per lane ([`u32::MAX`]: none).
+    ignored: [u32; MAX_LANES],
+    /// Every lane holds `masks[0]`.
+    same_mask: bool,
+    /// Every lane holds `ignored[0]`.
+    same_ignored: bool,
+}
+
+impl Visibility {
+    /// Every layer, nothing ignored: the default, which sees everything.
+    pub const ALL: Visibility = Visibility {
+        masks: [u32::MAX; MAX_LANES],
+        ignored: [u32::MAX; MAX_LANES],
+        same_mask: true,
+        same_ignored: true,
+    };
+
+    /// The layer mask `mask` in every lane.
+    #[must_use]
+    pub const fn mask(self, mask: u32) -> Self {
+        Visibility {
+            masks: [mask; MAX_LANES],
+            same_mask: true,
+            ..self
+        }
+    }
+
+    /// Lane `i` with the layer mask `masks[i]`; lanes past the slice get 0 (they see nothing).
+    #[must_use]
+    pub fn masks(self, masks: &[u32]) -> Self {
+        let (lanes, same) = per_lane(masks, 0);
+        Visibility {
+            masks: lanes,
+            same_mask: same,
+            ..self
+        }
+    }
+
+    /// Every lane ignores the set `set` ([`Hit::set`]).
+    #[must_use]
+    pub const fn ignore(self, set: u32) -> Self {
+        Visibility {
+            ignored: [set; MAX_LANES],
+            same_ignored: true,
+            ..self
+        }
+    }
+
+    /// Lane `i` ignores the set `sets[i]`; lanes past the slice ignore nothing.
+    #[must_use]
+    pub fn ignores(self, sets: &[u32]) -> Self {
+        let (lanes, same) = per_lane(sets, u32::MAX);
+        Visibility {
+            ignored: lanes,
+            same_ignored: same,
+            ..self
+        }
+    }
+
+    /// Lane `i`'s mask (0 past [`MAX_LANES`]).
+    #[must_use]
+    pub fn lane_mask(&self, i: usize) -> u32 {
+        self.masks.get(i).copied().unwrap_or(0)
+    }
+
+    /// The set lane `i` ignores ([`u32::MAX`]: none).
+    #[must_use]
+    pub fn lane_ignores(&self, i: usize) -> u32 {
+        self.ignored.get(i).copied().unwrap_or(u32::MAX)
+    }
+
+    /// True when some lane ignores a set.
+    fn ignoring(&self) -> bool {
+        !(self.same_ignored && self.ignored[0] == u32::MAX)
+    }
+
+    /// The lanes of `L` whose mask shares a bit with `mask`.
+    #[inline(always)]
+    fn share<L: Lane>(&self, mask: u32) -> L::Mask {
+        if self.same_mask {
+            return Mask::splat(self.masks[0] & mask != 0);
+        }
+        lanes::<L>(&self.masks, |m| m & mask != 0)
+    }
+
+    /// The lanes of `L` that ignore `set`.
+    #[inline(always)]
+    fn ignore_lanes<L: Lane>(&self, set: u32) -> L::Mask {
+        if self.same_ignored {
+            return Mask::splat(self.ignored[0] == set);
+        }
+        lanes::<L>(&self.ignored, |i| i == set)
+    }
+}
+
+impl Default for Visibility {
+    fn default() -> Self {
+        Visibility::ALL
+    }
+}
+
+/// `values` in lanes (`fill` past the slice), and whether every lane holds the first.
+fn per_lane(values: &[u32], fill: u32) -> ([u32; MAX_LANES], bool) {
+    let mut lanes = [fill; MAX_LANES];
+    for (l, v) in lanes.iter_mut().zip(values) {
+        *l = *v;
+    }
+    let same = lanes.iter().all(|&v| v == lanes[0]);
+    (lanes, same)
+}
+
+/// The lanes of `L` whose value passes `test`.
+#[inline(always)]
+fn lanes<L: Lane>(values: &[u32; MAX_LANES], test: impl Fn(u32) -> bool) -> L::Mask {
+    let mut m = L::Mask::splat(false);
+    for (i, &v) in values.iter().enumerate().take(L::LANES) {
+        if test(v) {
+            m = m.with_lane(i, true);
+        }
+    }
+    m
+}
+
+/// A collector seen through a query's [`Visibility`] (layer masks, an ignored set per lane)
+/// and [`Filter`]: the lanes whose mask is 0 are done before they start, a set of instances
+/// asks [`sees`](Collector::sees) which lanes see an instance (and traces it for those only),
+/// and every other candidate is put to the ignored sets and to the filter before the collector
+/// sees it. A rejected candidate never reaches the collector: it neither counts nor shrinks
+/// `t_max` (so the kernels' relaxed pruning never drops a winner behind it), `closest`
+/// continues past it, `any` does not stop on it and `all` does not report it. Answers
+/// therefore equal brute force over every candidate with the same masks, ignored sets and
+/// filter, at every width. With a filter, every root of a sphere is offered (the exit root
+/// counts when the filter rejects the entry root).
+///
+/// Without a filter ([`Unfiltered`]), with every mask bit set and nothing ignored, it is the
+/// collector itself (a lane mask `AND` per offer); queries that ask for none of them never
+/// build one, and their code is unchanged.
+pub struct Screen<'c, L: Lane, C, F> {
+    inner: &'c mut C,
+    sight: &'c Visibility,
+    /// The lanes whose mask is not 0.
+    seeing: L::Mask,
+    /// Some lane ignores a set.
+    ignoring: bool,
+    filter: &'c F,
+}
+
+impl<'c, L: Lane, C: Collector<L>, F: Filter> Screen<'c, L, C, F> {
+    /// `inner` seen through `sight` and `filter`.
+    #[inline(always)]
+    pub fn new(inner: &'c mut C, sight: &'c Visibility, filter: &'c F) -> Self {
+        Screen {
+            seeing: sight.share::<L>(u32::MAX),
+            ignoring: sight.ignoring(),
+            inner,
+            sight,
+            filter,
+        }
+    }
+
+    /// The lanes of `m` whose candidates in `h` (from `at`) the filter keeps.
+    #[inline(never)]
+    fn keep(&self, h: &LaneHit<L>, at: At, mut m: L::Mask) -> L::Mask {
+        let u = plus_zero(h.u / h.w);
+        let v = plus_zero(h.v / h.w);
+        let mut bits = m.bits();
+        while bits != 0 {
+            let j = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let c = Candidate {
+                set: at.set,
+                index: at.index,
+                t: h.t.lane(j).to_f64() as f32,
+                u: u.lane(j).to_f64() as f32,
+                v: v.lane(j).to_f64() as f32,
+                lane: j as u32,
+            };
+            if !self.filter.keep(&c) {
+                m = m.with_lane(j, false);
+            }
+        }
+        m
+    }
+}
+
+impl<L: Lane, C: Collector<L>, F: Filter> Collector<L> for Screen<'_, L, C, F> {
+    const EVERY: bool = C::EVERY;
+    const SHRINKS: bool = C::SHRINKS;
+    const EACH: bool = C::EACH || !F::NONE;
+
+    #[inline(always)]
+    fn active(&self) -> L::Mask {
+        self.inner.active() & self.seeing
+    }
+
+    #[inline(always)]
+    fn t_max(&self) -> L {
+        self.inner.t_max()
+    }
+
+    #[inline(always)]
+    fn sees(&self, set: u32, mask: u32) -> L::Mask {
+        let m = self.inner.sees(set, mask) & self.sight.share::<L>(mask);
+        if self.ignoring {
+            m.and_not(self.sight.ignore_lanes::<L>(set))
+        } else {
+            m
+        }
+    }
+
+    #[inline(always)]
+    fn offer(
+        &mut self,
+        h: &LaneHit<L>,
+        at: At,
+        record: impl FnOnce(&Winners<L>) -> Hits<L>,
+    ) -> bool {
+        let mut m = h.mask & self.seeing;
+        if self.ignoring {
+            m = m.and_not(self.sight.ignore_lanes::<L>(at.set));
+        }
+        if !F::NONE {
+            // Beyond the relaxed upper end nothing can count: the filter is not asked.
+            m = m & h.t.lt(self.inner.t_max());
+            if m.any() {
+                m = self.keep(h, at, m);
+            }
+        }
+        if m.none() {
+            return false;
+        }
+        let h = LaneHit { mask: m, ..*h };
+        self.inner.offer(&h, at, record) || self.active().none()
     }
 }
 

@@ -8,14 +8,18 @@
 //!   [`Query::culled`](crate::Query::culled));
 //! * [`Trace`]: anything a query can run, with its kernel chosen: every [`Set`] (with its
 //!   default kernel), a [`Using`], the focal caches ([`crate::focal`]) and tuples of up to four
-//!   of them, a scene whose hits carry the member's position in [`Hit::set`](crate::Hit::set).
+//!   of them, a scene whose hits carry the member's position in [`Hit::set`](crate::Hit::set);
+//! * [`Filtered`]: any of them seen through layer masks and a hit filter
+//!   ([`Screen`]).
 //!
 //! Flat sets test N rays × 1 primitive, in index order; `all` reports hits in that order
 //! (spheres: per sphere, its entry roots, then its exit roots).
 
 use core::marker::PhantomData;
 
-use crate::hit::{At, Collector, Hits, Record, Winners};
+use crate::hit::{
+    At, Candidate, Collector, Filter, Hits, Record, Screen, Unfiltered, Visibility, Winners,
+};
 use crate::kernel::{Cull, Kernel, admit};
 use crate::lane::{Lane, Mask};
 use crate::plane::{Plane, PlaneTest};
@@ -230,6 +234,138 @@ impl<S: Set + ?Sized> Set for &S {
     }
 }
 
+/// A set as a query with layer masks, an ignored set and a hit filter sees it (see
+/// [`Screen`]): made by [`Filtered::new`], given [`mask`](Self::mask) (one per query) or
+/// [`masks`](Self::masks) (one per ray lane), [`ignore`](Self::ignore) or
+/// [`ignores`](Self::ignores), and [`filter`](Self::filter), and queried like the set itself,
+/// for a ray, a packet or a tile. An instance whose mask shares no bit with a ray's is not
+/// seen by that ray; a set that carries no masks counts as carrying every bit; a rejected
+/// candidate is as if it did not exist (`closest` continues past it, `any` does not stop on
+/// it, `all` does not report it).
+///
+/// ```
+/// use raylane::glam::Vec3;
+/// use raylane::set::Filtered;
+/// use raylane::sphere::Sphere;
+/// use raylane::{Query, Ray};
+///
+/// let balls = [Sphere::new(Vec3::new(0.0, 0.0, -3.0), 1.0), Sphere::new(Vec3::new(0.0, 0.0, -6.0), 1.0)];
+/// let ray = Ray::new(Vec3::ZERO, Vec3::NEG_Z);
+/// assert_eq!(balls.closest(&ray).unwrap().t, 2.0);
+/// // Glass: sphere 0 lets the ray through; the closest hit is then sphere 1's.
+/// let seen = Filtered::new(&balls[..]).filter(|c| c.index != 0);
+/// assert_eq!(seen.closest(&ray).unwrap().t, 5.0);
+/// // A filter rejecting entry roots (u = 0 for spheres) leaves the exit root of sphere 0.
+/// let exits = Filtered::new(&balls[..]).filter(|c| c.u == 1.0);
+/// assert_eq!(exits.closest(&ray).unwrap().t, 4.0);
+/// // A query mask of 0 sees nothing.
+/// assert!(!Filtered::new(&balls[..]).mask(0).any(&ray));
+/// ```
+#[derive(Clone, Copy, Debug)]
+pub struct Filtered<'a, T: ?Sized, F = Unfiltered> {
+    set: &'a T,
+    sight: Visibility,
+    filter: F,
+}
+
+impl<'a, T: ?Sized> Filtered<'a, T> {
+    /// `set` seen by every mask bit and no filter (the set's own answers).
+    #[inline]
+    #[must_use]
+    pub fn new(set: &'a T) -> Self {
+        Filtered {
+            set,
+            sight: Visibility::ALL,
+            filter: Unfiltered,
+        }
+    }
+}
+
+impl<'a, T: ?Sized, F> Filtered<'a, T, F> {
+    /// Every ray (every lane of a packet, every pixel of a tile) with the layer mask `mask`.
+    #[inline]
+    #[must_use]
+    pub fn mask(self, mask: u32) -> Self {
+        Filtered {
+            sight: self.sight.mask(mask),
+            ..self
+        }
+    }
+
+    /// Lane `i` of a packet with the layer mask `masks[i]` (lanes past the slice: 0, nothing
+    /// seen); a ray is lane 0, and every packet of a tile gets the same lanes.
+    #[inline]
+    #[must_use]
+    pub fn masks(self, masks: &[u32]) -> Self {
+        Filtered {
+            sight: self.sight.masks(masks),
+            ..self
+        }
+    }
+
+    /// Every ray ignores the set `set` (a [`Hit::set`](crate::Hit::set): an instance of a
+    /// scene, a member of a tuple): its candidates do not count, and a scene does not trace
+    /// it ("ignore self").
+    #[inline]
+    #[must_use]
+    pub fn ignore(self, set: u32) -> Self {
+        Filtered {
+            sight: self.sight.ignore(set),
+            ..self
+        }
+    }
+
+    /// Lane `i` of a packet ignores the set `sets[i]` (lanes past the slice ignore nothing).
+    #[inline]
+    #[must_use]
+    pub fn ignores(self, sets: &[u32]) -> Self {
+        Filtered {
+            sight: self.sight.ignores(sets),
+            ..self
+        }
+    }
+
+    /// The same query with the filter `filter` (true to keep a candidate; see [`Filter`])
+    /// instead of this one.
+    #[inline]
+    #[must_use]
+    pub fn filter<G: Fn(&Candidate) -> bool>(self, filter: G) -> Filtered<'a, T, G> {
+        Filtered {
+            set: self.set,
+            sight: self.sight,
+            filter,
+        }
+    }
+
+    /// The set.
+    #[inline]
+    #[must_use]
+    pub fn set(&self) -> &'a T {
+        self.set
+    }
+}
+
+impl<T: Trace + ?Sized, F: Filter> Trace for Filtered<'_, T, F> {
+    #[inline]
+    fn sets(&self) -> u32 {
+        self.set.sets()
+    }
+    #[inline]
+    fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
+        let mut screen = Screen::new(c, &self.sight, &self.filter);
+        self.set.trace(rays, set, &mut screen)
+    }
+    #[inline]
+    fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
+        let mut screen = Screen::new(c, &self.sight, &self.filter);
+        self.set.trace_ray(ray, set, &mut screen)
+    }
+    #[inline]
+    fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
+        self.set.records(rays, set, w)
+    }
+}
+
 /// Caller storage too small: `needed` entries are required (nothing was written). The one
 /// error of every constructor that writes into caller storage (the focal caches; a BVH build
 /// says which of its slices in [`BuildError`](crate::bvh::BuildError)).
@@ -287,7 +423,7 @@ pub(crate) fn flat<P: Record, K: Kernel<P>, L: Lane, C: Collector<L>>(
             loc: i as u32,
         };
         let packet = p.splat::<L>();
-        let stop = if C::EVERY {
+        let stop = if C::EACH {
             K::each(&r, &pre, &packet, cull, |h| {
                 c.offer(h, at, |w| P::records(&rays, w, cull, |_| Some(p)))
             })

@@ -583,33 +583,52 @@ impl<P: Leaf, N: Layout> Bvh<'_, P, N> {
                     r4
                 };
                 let pre = pre.get_or_insert_with(|| K::prepare(&r4));
+                if C::EACH {
+                    // Every root of the four (a filter may reject an entry root).
+                    return K::each(&r, pre, &leaf.four(), cull, |h| {
+                        offer_four(h, leaf, li, set, c)
+                    });
+                }
                 let Some(h) = K::first(&r, pre, &leaf.four(), cull) else {
                     return false;
                 };
-                let mut bits = h.mask.bits();
-                while bits != 0 {
-                    let j = bits.trailing_zeros() as usize;
-                    bits &= bits - 1;
-                    let one = LaneHit {
-                        t: h.t.lane(j),
-                        u: h.u.lane(j),
-                        v: h.v.lane(j),
-                        w: h.w.lane(j),
-                        mask: true,
-                    };
-                    let at = At {
-                        set,
-                        index: leaf.indices().get(j).copied().unwrap_or(EMPTY),
-                        loc: li * LEAF_WIDTH as u32 + j as u32,
-                    };
-                    if c.offer(&one, at, |_| Hits::miss()) {
-                        return true;
-                    }
-                }
-                false
+                offer_four(&h, leaf, li, set, c)
             },
         )
     }
+}
+
+/// The hits of one ray against the four primitives of leaf `li` (lane `j`: primitive `j`),
+/// offered to `c` one by one; true when `c` asked to stop.
+#[inline(always)]
+fn offer_four<P: Packed, C: Collector<f32>>(
+    h: &LaneHit<f32x4>,
+    leaf: &P,
+    li: u32,
+    set: u32,
+    c: &mut C,
+) -> bool {
+    let mut bits = h.mask.bits();
+    while bits != 0 {
+        let j = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let one = LaneHit {
+            t: h.t.lane(j),
+            u: h.u.lane(j),
+            v: h.v.lane(j),
+            w: h.w.lane(j),
+            mask: true,
+        };
+        let at = At {
+            set,
+            index: leaf.indices().get(j).copied().unwrap_or(EMPTY),
+            loc: li * LEAF_WIDTH as u32 + j as u32,
+        };
+        if c.offer(&one, at, |_| Hits::miss()) {
+            return true;
+        }
+    }
+    false
 }
 
 /// Lanes at or below which a packet's subtree continues lane by lane as single rays (`0`:
@@ -751,7 +770,7 @@ pub(crate) fn leaf_many<P: Leaf, K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
             loc: li * LEAF_WIDTH as u32 + k as u32,
         };
         let record = |w: &Winners<L>| P::Prim::records(rays, w, cull, |_| Some(leaf.prim(k)));
-        let stop = if C::EVERY {
+        let stop = if C::EACH {
             K::each(&r, pre, &p, cull, |h| c.offer(h, at, record))
         } else {
             K::first(&r, pre, &p, cull).is_some_and(|h| h.mask.any() && c.offer(&h, at, record))
