@@ -22,11 +22,12 @@
 //! tested by every ray (still exact, only slower).
 
 use glam::Vec3;
+use wide::f32x4;
 
-use super::leaf::points_box;
+use super::node::Slab;
 use super::{
     BuildError, Bvh, EMPTY, LEAF_WIDTH, Layout, Leaf, Node, Packed, Primitives, Scratch, Sizes,
-    max, sizes, traverse,
+    max, min, sizes, traverse,
 };
 use crate::hit::{Collector, Hit, Hits, Winners};
 use crate::kernel::{Cull, Kernel};
@@ -97,16 +98,7 @@ impl Instance {
     #[must_use]
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub fn ray_to_object(&self, ray: &Ray) -> Ray {
-        let m = &self.to_object;
-        let (o, d) = (ray.origin(), ray.dir());
-        let p = |r: usize| ((m[r][0] * o.x + m[r][1] * o.y) + m[r][2] * o.z) + m[r][3];
-        let v = |r: usize| (m[r][0] * d.x + m[r][1] * d.y) + m[r][2] * d.z;
-        Ray::with_interval(
-            Vec3::new(p(0), p(1), p(2)),
-            Vec3::new(v(0), v(1), v(2)),
-            ray.t_min(),
-            ray.t_max(),
-        )
+        object_ray(&self.to_object, ray)
     }
 
     /// The world rays of a packet in object space, lane by lane as
@@ -115,35 +107,37 @@ impl Instance {
     #[must_use]
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub fn packet_to_object<L: Lane>(&self, rays: &RayPacket<L>) -> RayPacket<L> {
-        let m = &self.to_object;
-        let (o, d) = (rays.origin, rays.dir);
-        let c = |x: f32| L::from_f32(x);
-        let p = |r: usize| ((c(m[r][0]) * o.x + c(m[r][1]) * o.y) + c(m[r][2]) * o.z) + c(m[r][3]);
-        let v = |r: usize| (c(m[r][0]) * d.x + c(m[r][1]) * d.y) + c(m[r][2]) * d.z;
-        RayPacket::new(
-            V3::new(p(0), p(1), p(2)),
-            V3::new(v(0), v(1), v(2)),
-            rays.t_min,
-            rays.t_max,
-        )
+        object_packet(&self.to_object, rays)
+    }
+
+    /// An object record in world space: point on the world ray, normal `Mᵀ·n` normalised.
+    pub(crate) fn world_record(&self, i: u32, ray: &Ray, h: Hit) -> Hit {
+        world_record(&self.to_object, self.mirror, i, ray, h)
     }
 
     /// The world box of an object box (empty in, empty out; infinite when not invertible).
-    fn world_box(&self, lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+    pub(crate) fn world_box(&self, lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
         if !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]) {
             return ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
         }
         if !self.invertible {
             return ([f32::NEG_INFINITY; 3], [f32::INFINITY; 3]);
         }
+        // The 8 corners `p` (coordinate k from `hi` where bit k of the corner's number is set),
+        // each world coordinate `((a0·p0 + a1·p1) + a2·p2) + b` (a product per row and end
+        // made once), taken into the box in the corners' order (which decides between ±0).
         let a = &self.to_world;
-        let mut corners = [Vec3::ZERO; 8];
-        for (i, c) in corners.iter_mut().enumerate() {
-            let p = [0, 1, 2].map(|k| if i >> k & 1 == 1 { hi[k] } else { lo[k] });
-            let w = |r: usize| ((a[r][0] * p[0] + a[r][1] * p[1]) + a[r][2] * p[2]) + a[r][3];
-            *c = Vec3::new(w(0), w(1), w(2));
+        let (mut out_lo, mut out_hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for r in 0..3 {
+            let ends = |k: usize| [a[r][k] * lo[k], a[r][k] * hi[k]];
+            let (x, y, z) = (ends(0), ends(1), ends(2));
+            for i in 0..8 {
+                let w = ((x[i & 1] + y[i >> 1 & 1]) + z[i >> 2 & 1]) + a[r][3];
+                out_lo[r] = min(out_lo[r], w);
+                out_hi[r] = max(out_hi[r], w);
+            }
         }
-        let (mut lo, mut hi) = points_box(&corners);
+        let (mut lo, mut hi) = (out_lo, out_hi);
         let mut big = 0.0f32;
         for k in 0..3 {
             big = max(big, max(lo[k].abs(), hi[k].abs()));
@@ -154,6 +148,57 @@ impl Instance {
             hi[k] += m;
         }
         (lo, hi)
+    }
+}
+
+/// [`Instance::ray_to_object`] with the world→object map `m`.
+#[inline]
+pub(crate) fn object_ray(m: &[[f32; 4]; 3], ray: &Ray) -> Ray {
+    let (o, d) = (ray.origin(), ray.dir());
+    let p = |r: usize| ((m[r][0] * o.x + m[r][1] * o.y) + m[r][2] * o.z) + m[r][3];
+    let v = |r: usize| (m[r][0] * d.x + m[r][1] * d.y) + m[r][2] * d.z;
+    Ray::with_interval(
+        Vec3::new(p(0), p(1), p(2)),
+        Vec3::new(v(0), v(1), v(2)),
+        ray.t_min(),
+        ray.t_max(),
+    )
+}
+
+/// [`Instance::packet_to_object`] with the world→object map `m`.
+#[inline]
+pub(crate) fn object_packet<L: Lane>(m: &[[f32; 4]; 3], rays: &RayPacket<L>) -> RayPacket<L> {
+    let (o, d) = (rays.origin, rays.dir);
+    let c = |x: f32| L::from_f32(x);
+    let p = |r: usize| ((c(m[r][0]) * o.x + c(m[r][1]) * o.y) + c(m[r][2]) * o.z) + c(m[r][3]);
+    let v = |r: usize| (c(m[r][0]) * d.x + c(m[r][1]) * d.y) + c(m[r][2]) * d.z;
+    RayPacket::new(
+        V3::new(p(0), p(1), p(2)),
+        V3::new(v(0), v(1), v(2)),
+        rays.t_min,
+        rays.t_max,
+    )
+}
+
+/// An object record `h` of instance `i` (world→object map `m`, mirroring when `mirror`) in
+/// world space: point on the world ray, normal `Mᵀ·n` normalised, the face flipped when the
+/// transform mirrors.
+pub(crate) fn world_record(m: &[[f32; 4]; 3], mirror: bool, i: u32, ray: &Ray, h: Hit) -> Hit {
+    let n = h.normal;
+    let w = |c: usize| (m[0][c] * n.x + m[1][c] * n.y) + m[2][c] * n.z;
+    let v = V3::<f32>::from(Vec3::new(w(0), w(1), w(2)));
+    let len = v.length_squared().sqrt();
+    let normal = if len > 0.0 && len.is_finite() {
+        v.div_by(len).into()
+    } else {
+        Vec3::ZERO
+    };
+    Hit {
+        point: ray.at(h.t),
+        normal,
+        front: h.front != mirror,
+        set: i,
+        ..h
     }
 }
 
@@ -217,12 +262,18 @@ impl<P: Packed, N: Layout> Primitives for Placed<'_, '_, P, N> {
         }
     }
     fn put(&self, i: u32, leaf: &mut Inst4, k: usize) {
-        let (lo, hi) = self.bounds(i);
+        leaf.put(k, i, self.bounds(i));
+    }
+}
+
+impl Inst4 {
+    /// Lane `k` set to instance `i` with the world box `(lo, hi)`.
+    pub(crate) fn put(&mut self, k: usize, i: u32, (lo, hi): ([f32; 3], [f32; 3])) {
         for a in 0..3 {
-            leaf.bounds[a][k] = lo[a];
-            leaf.bounds[3 + a][k] = hi[a];
+            self.bounds[a][k] = lo[a];
+            self.bounds[3 + a][k] = hi[a];
         }
-        leaf.index[k] = i;
+        self.index[k] = i;
     }
 }
 
@@ -274,28 +325,6 @@ impl<'s, P: Leaf, N: Layout> Scene<'s, P, N> {
         let inst = self.instances.get(i as usize)?;
         Some((inst, self.objects.get(inst.object as usize)?))
     }
-
-    /// An object record in world space: point on the world ray, normal `Mᵀ·n` normalised.
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    fn world_record(inst: &Instance, i: u32, ray: &Ray, h: Hit) -> Hit {
-        let m = &inst.to_object;
-        let n = h.normal;
-        let w = |c: usize| (m[0][c] * n.x + m[1][c] * n.y) + m[2][c] * n.z;
-        let v = V3::<f32>::from(Vec3::new(w(0), w(1), w(2)));
-        let len = v.length_squared().sqrt();
-        let normal = if len > 0.0 && len.is_finite() {
-            v.div_by(len).into()
-        } else {
-            Vec3::ZERO
-        };
-        Hit {
-            point: ray.at(h.t),
-            normal,
-            front: h.front != inst.mirror,
-            set: i,
-            ..h
-        }
-    }
 }
 
 /// A scene answers like its instances queried one by one with the same kernel and culling:
@@ -320,26 +349,16 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         set: u32,
         c: &mut C,
     ) -> bool {
-        traverse::many(
-            self.top.nodes,
-            self.top.reach,
+        instances(
+            &self.top,
             rays,
             c,
-            #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |li, r, _, c| {
-                let Some(leaf) = self.top.leaves.get(li as usize) else {
+            |i, r, c| {
+                let Some((inst, object)) = self.placed(i) else {
                     return false;
                 };
-                for &i in leaf.indices() {
-                    let Some((inst, object)) = self.placed(i) else {
-                        continue;
-                    };
-                    let local = inst.packet_to_object(r);
-                    if object.trace_with::<K, L, C>(cull, &local, set + i, c) {
-                        return true;
-                    }
-                }
-                false
+                let local = inst.packet_to_object(r);
+                object.trace_with::<K, L, C>(cull, &local, set + i, c)
             },
             0,
             |_, _, _| false,
@@ -356,29 +375,13 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         if C::EVERY {
             return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
         }
-        traverse::one(
-            self.top.nodes,
-            self.top.reach,
-            ray,
-            0,
-            c,
-            #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |li, c| {
-                let Some(leaf) = self.top.leaves.get(li as usize) else {
-                    return false;
-                };
-                for &i in leaf.indices() {
-                    let Some((inst, object)) = self.placed(i) else {
-                        continue;
-                    };
-                    let local = inst.ray_to_object(ray);
-                    if object.trace_ray_with::<K, C>(cull, &local, set + i, c) {
-                        return true;
-                    }
-                }
-                false
-            },
-        )
+        instances_one(&self.top, ray, 0, c, |i, c| {
+            let Some((inst, object)) = self.placed(i) else {
+                return false;
+            };
+            let local = inst.ray_to_object(ray);
+            object.trace_ray_with::<K, C>(cull, &local, set + i, c)
+        })
     }
 
     fn records_with<L: Lane>(
@@ -388,39 +391,120 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         set: u32,
         w: &Winners<L>,
     ) -> Hits<L> {
-        let w = owned(w, set, self.sets());
-        let mut out = Hits::<L>::miss();
-        let mut bits = w.mask.bits();
-        while bits != 0 {
-            let j = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
-            let Some(ray) = lane_ray(rays, j) else {
-                continue;
-            };
-            let get = |x: &L::Indices| x.as_ref().get(j).copied().unwrap_or(u32::MAX);
-            let i = get(&w.set).wrapping_sub(set);
-            let Some((inst, object)) = self.placed(i) else {
-                continue;
-            };
-            let local = inst.ray_to_object(&ray);
-            let one = Winners::<f32> {
-                t: lane(w.t, j),
-                u: lane(w.u, j),
-                v: lane(w.v, j),
-                index: [get(&w.index)],
-                set: [0],
-                loc: [get(&w.loc)],
-                mask: true,
-            };
+        instance_records(rays, set, self.sets(), w, |i, ray, one| {
+            let (inst, object) = self.placed(i)?;
+            let local = inst.ray_to_object(ray);
             let h = object
-                .records_with(cull, &RayPacket::splat(&local), 0, &one)
-                .lane(0);
-            if let Some(h) = h {
-                out.set_lane(j, Some(&Self::world_record(inst, set + i, &ray, h)));
+                .records_with(cull, &RayPacket::splat(&local), 0, one)
+                .lane(0)?;
+            Some(inst.world_record(set + i, ray, h))
+        })
+    }
+}
+
+/// The top level's traversal for a packet (the one packet traversal, leaves of instances):
+/// `visit(i, rays, c)` for the instances `i` of every leaf the rays reach (unused lanes give
+/// [`EMPTY`]), with the rays' intervals shrunk to the collector's, until it returns true. With
+/// the packet's frustum ([`Cone`](traverse::Cone)), only the instances whose own world boxes
+/// it may enter (a pure prune, as for a leaf's primitives). Subtrees that `split` or fewer
+/// lanes reach go to `single(node, lane, c)` (as [`traverse::many`]; `split = 0`: never).
+#[inline(always)]
+pub(crate) fn instances<L: Lane, C: Collector<L>>(
+    top: &Bvh<'_, Inst4>,
+    rays: &RayPacket<L>,
+    c: &mut C,
+    mut visit: impl FnMut(u32, &RayPacket<L>, &mut C) -> bool,
+    split: u32,
+    single: impl FnMut(u32, usize, &mut C) -> bool,
+) -> bool {
+    traverse::many(
+        top.nodes,
+        top.reach,
+        rays,
+        c,
+        |li, r, cone, c| {
+            let Some(leaf) = top.leaves.get(li as usize) else {
+                return false;
+            };
+            let keep = cone.map_or(u32::MAX, |f| f.enters(leaf.bounds.map(f32x4::new)));
+            for (k, &i) in leaf.indices().iter().enumerate() {
+                if keep & (1 << k) != 0 && visit(i, r, c) {
+                    return true;
+                }
+            }
+            false
+        },
+        split,
+        single,
+    )
+}
+
+/// [`instances`] for one ray from the node reference `start` (0: the root; the one-ray
+/// traversal): `visit(i, c)` per instance reached whose own world box the ray's interval
+/// meets (the nodes' slab test on the leaf's four boxes, made at the first leaf: a pure
+/// prune), in the leaf's order.
+#[inline(always)]
+pub(crate) fn instances_one<C: Collector<f32>>(
+    top: &Bvh<'_, Inst4>,
+    ray: &Ray,
+    start: u32,
+    c: &mut C,
+    mut visit: impl FnMut(u32, &mut C) -> bool,
+) -> bool {
+    let mut slab = None;
+    traverse::one(top.nodes, top.reach, ray, start, c, |li, c| {
+        let Some(leaf) = top.leaves.get(li as usize) else {
+            return false;
+        };
+        let slab = slab.get_or_insert_with(|| Slab::new(ray.origin(), ray.dir(), top.reach));
+        let boxes = leaf.bounds.map(f32x4::new);
+        let (mut bits, _) = slab.test4(&boxes, &leaf.index, ray.t_min(), c.t_max());
+        while bits != 0 {
+            let k = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            if visit(leaf.index[k], c) {
+                return true;
             }
         }
-        out
+        false
+    })
+}
+
+/// The records of a scene's winners `w` (sets `set..set + n`: instance `set[j] − set`), lane
+/// by lane: `record(i, ray, one)` makes lane `j`'s world record from instance `i`, the lane's
+/// world ray and its winner alone (`set` 0).
+pub(crate) fn instance_records<L: Lane>(
+    rays: &RayPacket<L>,
+    set: u32,
+    n: u32,
+    w: &Winners<L>,
+    record: impl Fn(u32, &Ray, &Winners<f32>) -> Option<Hit>,
+) -> Hits<L> {
+    let w = owned(w, set, n);
+    let mut out = Hits::<L>::miss();
+    let mut bits = w.mask.bits();
+    while bits != 0 {
+        let j = bits.trailing_zeros() as usize;
+        bits &= bits - 1;
+        let Some(ray) = lane_ray(rays, j) else {
+            continue;
+        };
+        let get = |x: &L::Indices| x.as_ref().get(j).copied().unwrap_or(u32::MAX);
+        let i = get(&w.set).wrapping_sub(set);
+        let one = Winners::<f32> {
+            t: lane(w.t, j),
+            u: lane(w.u, j),
+            v: lane(w.v, j),
+            index: [get(&w.index)],
+            set: [0],
+            loc: [get(&w.loc)],
+            mask: true,
+        };
+        if let Some(h) = record(i, &ray, &one) {
+            out.set_lane(j, Some(&h));
+        }
     }
+    out
 }
 
 /// Lane `j` as an `f32`.
@@ -440,4 +524,76 @@ fn lane_ray<L: Lane>(rays: &RayPacket<L>, j: usize) -> Option<Ray> {
         lane(rays.t_max, j),
     );
     r.is_valid().then_some(r)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::bvh::leaf::points_box;
+
+    /// The world box as first written: the 8 corners through the transform, then their box.
+    fn corners_box(inst: &Instance, lo: [f32; 3], hi: [f32; 3]) -> ([f32; 3], [f32; 3]) {
+        let a = &inst.to_world;
+        let mut corners = [Vec3::ZERO; 8];
+        for (i, c) in corners.iter_mut().enumerate() {
+            let p = [0, 1, 2].map(|k| if i >> k & 1 == 1 { hi[k] } else { lo[k] });
+            let w = |r: usize| ((a[r][0] * p[0] + a[r][1] * p[1]) + a[r][2] * p[2]) + a[r][3];
+            *c = Vec3::new(w(0), w(1), w(2));
+        }
+        points_box(&corners)
+    }
+
+    /// `world_box` takes the corners' coordinates into the box in the corners' order, with
+    /// the same operations: the same bits as the corners' box (signed zeros, NaN, infinities).
+    #[test]
+    fn world_box_is_the_corners_box() {
+        let values = [
+            0.0,
+            -0.0,
+            1.0,
+            -1.0,
+            0.5,
+            -2.5,
+            3.0e-39,
+            1.0e30,
+            -1.0e30,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        let mut seed = 1u64;
+        let mut pick = || {
+            seed = seed
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            values[(seed >> 33) as usize % values.len()]
+        };
+        for _ in 0..20_000 {
+            let m = [0, 1, 2].map(|_| [pick(), pick(), pick(), pick()]);
+            let lo = [pick(), pick(), pick()];
+            let hi = [pick(), pick(), pick()];
+            let mut inst = Instance::new(0, m);
+            inst.invertible = true;
+            let (wlo, whi) = inst.world_box(lo, hi);
+            if !(lo[0] <= hi[0] && lo[1] <= hi[1] && lo[2] <= hi[2]) {
+                continue;
+            }
+            let (mut clo, mut chi) = corners_box(&inst, lo, hi);
+            let mut big = 0.0f32;
+            for k in 0..3 {
+                big = max(big, max(clo[k].abs(), chi[k].abs()));
+            }
+            let e = big * (1.0 / 1024.0);
+            for k in 0..3 {
+                clo[k] -= e;
+                chi[k] += e;
+            }
+            let bits = |b: [f32; 3]| b.map(f32::to_bits);
+            assert_eq!(
+                (bits(wlo), bits(whi)),
+                (bits(clo), bits(chi)),
+                "{m:?} {lo:?} {hi:?}"
+            );
+        }
+    }
 }
