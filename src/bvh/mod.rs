@@ -133,11 +133,15 @@ pub mod bake;
 mod build;
 mod leaf;
 pub mod node;
+#[cfg(feature = "alloc")]
+pub mod owned_scene;
 pub mod scene;
 mod traverse;
 
 pub use leaf::{Leaf, Packed, Primitives, Sphere4, Tri4};
 pub use node::{Layout, Node, Node4};
+#[cfg(feature = "alloc")]
+pub use owned_scene::{Commit, InstanceId, Object, ObjectId, OwnedScene, SceneError};
 pub use scene::{Inst4, Instance, Scene};
 
 use wide::f32x4;
