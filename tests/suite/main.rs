@@ -25,6 +25,7 @@ mod sets {
     pub mod bunny_visible_surface;
     pub mod camera_tiles;
     pub mod interval_ties_and_stopping;
+    pub mod masks_and_filters;
     pub mod query_records_every_width;
 }
 
@@ -32,6 +33,7 @@ mod bvh {
     pub mod baked_trees;
     pub mod equals_brute_force;
     pub mod from_parts_checked;
+    pub mod owned_scenes;
 }
 
 mod targets {
