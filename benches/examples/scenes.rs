@@ -115,6 +115,8 @@ struct Results {
     order: Vec<(String, usize)>,
     /// Check failures.
     failed: Vec<String>,
+    /// The engine's frame (issue 30): the table's rows and notes.
+    game: Option<Game>,
 }
 
 struct Opts {
@@ -923,6 +925,9 @@ fn main() {
     if wanted("spheres") {
         sphere_scene(&mut res, 100_000, &opts);
     }
+    if wanted("game") {
+        res.game = Some(game_frame(&opts));
+    }
     report(&res);
     println!("\n(total {:.0} s)", started.elapsed().as_secs_f64());
 }
@@ -943,6 +948,13 @@ fn get(res: &Results, kind: Kind, scene: &str, c: &str) -> Option<f64> {
 }
 
 fn report(res: &Results) {
+    if res.order.is_empty() {
+        // Only the engine's frame ran.
+        if let Some(g) = &res.game {
+            g.report();
+        }
+        return;
+    }
     println!("\n## Scenes of 10^3 to 10^6 primitives (issues 14 and 20)\n");
     println!(
         "CPU: {}; one thread for every contender (Embree's device too) but the section \"On every core\". Primary rays in tiles of 16 × 16 pixels, 4 × 4 blocks inside: every packet of 16 (8) consecutive rays is a block of 4 × 4 (4 × 2) pixels, for every contender.\n",
@@ -1158,6 +1170,9 @@ fn report(res: &Results) {
             );
         }
     }
+    if let Some(g) = &res.game {
+        g.report();
+    }
     if !res.failed.is_empty() {
         println!("\nNot timed (answers differ from the reference):\n");
         for f in &res.failed {
@@ -1173,5 +1188,321 @@ fn short(n: usize) -> String {
         format!("{:.1} k", n as f64 / 1e3)
     } else {
         n.to_string()
+    }
+}
+
+#[path = "../../examples/game/world.rs"]
+mod world;
+
+/// The engine's frame of issue 30 against Embree's instance API: what was measured.
+struct Game {
+    frames: usize,
+    instances: usize,
+    /// (what, raylane ms, Embree ms with `RTC_SCENE_FLAG_DYNAMIC` + `LOW`, Embree ms default)
+    rows: Vec<(String, f64, f64, f64)>,
+    /// Rays whose answers differ from raylane's, per query kind (dynamic, default).
+    differ: Vec<(String, usize, usize)>,
+    masks: bool,
+    /// raylane's commits: (refits, rebuilds).
+    commits: (usize, usize),
+}
+
+/// The frame of `examples/game` (its world, included: the same shapes, 10,000 instances, the
+/// same moves and rays), one thread each, raylane's `OwnedScene` against Embree 3's instance
+/// API in two configurations of the top level. Every frame: everything moves; raylane's
+/// `set_transform` of every instance and `commit` against Embree's `rtcSetGeometryTransform`
+/// and `rtcCommitGeometry` of every instance and `rtcCommitScene`; then the queries (a pick,
+/// 1,000 sight lines on every layer but the agents', 10,000 bullets ignoring their shooters,
+/// by a filter closure and by `ignoring`, against Embree's filter callback, a shadow ray from
+/// each of raylane's bullet impacts), one ray per call (`rtcIntersect1`, `rtcOccluded1`), the
+/// contenders in turn (the order rotating by frame); the medians over the frames. Answers are
+/// compared frame by frame (not timed): hit or miss, `t` (within 10^-3 relative, plus the
+/// rounding of the origin's coordinates), and for bullets the instance hit.
+fn game_frame(opts: &Opts) -> Game {
+    use raylane::bvh::{OwnedBvh, OwnedScene};
+    use raylane_bench::embree::{Instances, Shape};
+    use world::{AGENTS, Prims};
+
+    let frames = opts.runs.unwrap_or(15).max(3);
+    let shapes = world::shapes();
+    let mut actors = world::actors(10_000, 1);
+    let agents = world::agents(&actors);
+    println!(
+        "\n### An engine's frame: {} instances of {} shapes, {frames} frames",
+        actors.len(),
+        shapes.len()
+    );
+    let mut scene = OwnedScene::new();
+    let objects: Vec<_> = shapes
+        .iter()
+        .map(|s| match &s.prims {
+            Prims::Mesh(t) => scene.add_object(OwnedBvh::new(&t[..]).unwrap()),
+            Prims::Balls(b) => scene.add_object(OwnedBvh::new(&b[..]).unwrap()),
+        })
+        .collect();
+    let ids: Vec<_> = actors
+        .iter()
+        .map(|a| {
+            scene
+                .add(objects[a.shape], world::rows(a), a.layer)
+                .unwrap()
+        })
+        .collect();
+    scene.commit();
+    let eshapes: Vec<Shape> = shapes
+        .iter()
+        .map(|s| match &s.prims {
+            Prims::Mesh(t) => Shape::Triangles(t),
+            Prims::Balls(b) => Shape::Spheres(b),
+        })
+        .collect();
+    let placed: Vec<_> = actors
+        .iter()
+        .map(|a| (a.shape, a.layer, world::rows(a)))
+        .collect();
+    let mut emb = [
+        Instances::new(&eshapes, &placed, true),
+        Instances::new(&eshapes, &placed, false),
+    ];
+    let masks = emb[0].ray_masks();
+    println!(
+        "  Embree ray masks: {}",
+        if masks {
+            "supported (instance masks)"
+        } else {
+            "not in this build: layers through an occlusion filter callback"
+        }
+    );
+    // (step) -> per contender, the frame times.
+    const STEPS: [&str; 7] = [
+        "stage", "commit", "pick", "sight", "bullets", "ignore", "shadows",
+    ];
+    let mut times = vec![[Vec::new(), Vec::new(), Vec::new()]; STEPS.len()];
+    let mut differ = [[0usize; 2]; 3];
+    let mut commits = (0, 0);
+    let mut rng = world::Rng::new(2);
+    let cam = Pinhole::look_at(
+        Vec3::new(0.0, 90.0, 140.0),
+        Vec3::ZERO,
+        Vec3::Y,
+        60.0,
+        1280,
+        720,
+    );
+    // `t` agrees within 10^-3 of itself plus 2^-18 of the origin's largest coordinate over
+    // `|d|` (hits a few hundredths from an origin 200 units out carry its rounding: an agent
+    // standing inside a crate).
+    let far = |r: &Ray, a: f32, b: f32| {
+        let o = r.origin().abs().max_element() as f64 / r.dir().length() as f64;
+        (a as f64 - b as f64).abs() > 1e-3 * (b as f64).abs() + o * (1.0 / 262_144.0)
+    };
+    for frame in 0..frames {
+        world::step(&mut actors, 1.0 / 60.0);
+        let rows: Vec<[[f32; 4]; 3]> = actors.iter().map(world::rows).collect();
+        let lines = world::sight_lines(&actors, &agents, 1000, &mut rng);
+        let shots = world::bullets(&actors, &agents, 10_000, &mut rng);
+        let (cx, cy) = (
+            640 + (500.0 * (frame as f32 * 0.05).cos()) as u32,
+            360 + (300.0 * (frame as f32 * 0.07).sin()) as u32,
+        );
+        let cursor = cam.row_packet::<f32>(cx, cy).ray(0);
+        // raylane's answers give the shadow rays of both.
+        let impacts: Vec<raylane::Hit> = Vec::new();
+        let mut impacts = Some(impacts);
+        for turn in 0..3 {
+            let who = (turn + frame) % 3;
+            let mut tick =
+                |step: usize, t: Instant| times[step][who].push(t.elapsed().as_secs_f64() * 1e3);
+            if who == 0 {
+                let t = Instant::now();
+                for (id, r) in ids.iter().zip(&rows) {
+                    scene.set_transform(*id, *r).unwrap();
+                }
+                tick(0, t);
+                let t = Instant::now();
+                let how = scene.commit();
+                tick(1, t);
+                match how {
+                    raylane::bvh::Commit::Refit => commits.0 += 1,
+                    raylane::bvh::Commit::Rebuild => commits.1 += 1,
+                    raylane::bvh::Commit::Unchanged => {}
+                }
+                let t = Instant::now();
+                std::hint::black_box(scene.closest(&cursor));
+                tick(2, t);
+                let t = Instant::now();
+                let seen = scene.masked(!AGENTS);
+                std::hint::black_box(lines.iter().filter(|(_, _, r)| !seen.any(r)).count());
+                tick(3, t);
+                let t = Instant::now();
+                let hits: Vec<raylane::Hit> = shots
+                    .iter()
+                    .filter_map(|(s, r)| {
+                        let me = ids[*s].slot();
+                        scene.filtered(|c| c.set != me).closest(r)
+                    })
+                    .collect();
+                tick(4, t);
+                let t = Instant::now();
+                let ignored: Vec<raylane::Hit> = shots
+                    .iter()
+                    .filter_map(|(s, r)| scene.ignoring(ids[*s]).closest(r))
+                    .collect();
+                tick(5, t);
+                assert_eq!(ignored, hits, "ignore is the filter's job");
+                let t = Instant::now();
+                std::hint::black_box(
+                    hits.iter()
+                        .filter(|h| !scene.any(&world::shadow(h.point)))
+                        .count(),
+                );
+                tick(6, t);
+                impacts = Some(hits);
+            } else {
+                let e = &mut emb[who - 1];
+                let _ftz = raylane_bench::embree::FlushDenormals::on();
+                let t = Instant::now();
+                e.set_transforms(rows.iter());
+                tick(0, t);
+                let t = Instant::now();
+                e.commit();
+                tick(1, t);
+                let t = Instant::now();
+                std::hint::black_box(e.closest(&cursor, u32::MAX));
+                tick(2, t);
+                let t = Instant::now();
+                std::hint::black_box(
+                    lines
+                        .iter()
+                        .filter(|(_, _, r)| !e.occluded(r, !AGENTS))
+                        .count(),
+                );
+                tick(3, t);
+                let t = Instant::now();
+                let hits: Vec<_> = shots.iter().map(|(s, r)| e.closest(r, *s as u32)).collect();
+                let ms = t.elapsed().as_secs_f64() * 1e3;
+                // One Embree run for both rows: its filter callback does either job.
+                times[4][who].push(ms);
+                times[5][who].push(ms);
+                std::hint::black_box(&hits);
+            }
+        }
+        // The answers, compared (not timed).
+        let _ftz = raylane_bench::embree::FlushDenormals::on();
+        let ours = impacts.take().unwrap_or_default();
+        for (k, e) in emb.iter().enumerate() {
+            let seen = scene.masked(!AGENTS);
+            differ[0][k] += lines
+                .iter()
+                .filter(|(_, _, r)| seen.any(r) != e.occluded(r, !AGENTS))
+                .count();
+            for (s, r) in &shots {
+                let me = ids[*s].slot();
+                let mine = scene.filtered(|c| c.set != me).closest(r);
+                let theirs = e.closest(r, *s as u32);
+                let bad = match (mine, theirs) {
+                    (None, None) => false,
+                    (Some(h), Some((t, inst, _))) => far(r, h.t, t) || h.set != inst,
+                    _ => true,
+                };
+                differ[1][k] += usize::from(bad);
+            }
+            differ[2][k] += ours
+                .iter()
+                .filter(|h| {
+                    let r = world::shadow(h.point);
+                    scene.any(&r) != e.occluded(&r, u32::MAX)
+                })
+                .count();
+        }
+        // Embree's shadow rays, timed after its answers were checked (the same rays as ours).
+        for (k, e) in emb.iter().enumerate() {
+            let t = Instant::now();
+            std::hint::black_box(
+                ours.iter()
+                    .filter(|h| !e.occluded(&world::shadow(h.point), u32::MAX))
+                    .count(),
+            );
+            times[6][k + 1].push(t.elapsed().as_secs_f64() * 1e3);
+        }
+    }
+    let names = [
+        "stage the moves (10,000 transforms)",
+        "commit",
+        "pick (1 ray)",
+        "sight lines (1,000, masked)",
+        "bullets (10,000, a filter closure ignores the shooter)",
+        "bullets (10,000, `ignoring(shooter)`)",
+        "shadow rays (one per impact)",
+    ];
+    let rows = names
+        .iter()
+        .enumerate()
+        .map(|(k, n)| {
+            let m = |c: usize| median(times[k][c].clone());
+            (n.to_string(), m(0), m(1), m(2))
+        })
+        .collect();
+    let differ = ["sight lines", "bullets", "shadow rays"]
+        .iter()
+        .zip(differ)
+        .map(|(n, d)| (n.to_string(), d[0], d[1]))
+        .collect();
+    Game {
+        frames,
+        instances: actors.len(),
+        rows,
+        differ,
+        masks,
+        commits,
+    }
+}
+
+impl Game {
+    fn report(&self) {
+        println!(
+            "\n## An engine's frame (issue 30): raylane's `OwnedScene` against Embree's instance API\n"
+        );
+        println!(
+            "`examples/game`'s world: {} instances of 7 shapes (meshes and sphere sets), all moving every frame; medians of {} frames, one thread each, one ray per query. Embree's layers: {}; bullets ignore their shooter through an intersection filter callback. Factor: Embree's milliseconds over raylane's (above 1: raylane faster). raylane's commits: {} refits, {} rebuilds.\n",
+            self.instances,
+            self.frames,
+            if self.masks {
+                "instance and ray masks"
+            } else {
+                "this build has no ray masks (`RTC_DEVICE_PROPERTY_RAY_MASK_SUPPORTED` is 0), so an occlusion filter callback rejects the agents' hits: the same job"
+            },
+            self.commits.0,
+            self.commits.1
+        );
+        println!(
+            "| per frame | raylane ms | Embree ms (dynamic, low) | factor | Embree ms (default) | factor |"
+        );
+        println!("| --- | ---: | ---: | ---: | ---: | ---: |");
+        let mut total = [0.0; 3];
+        for (n, r, d, e) in &self.rows {
+            println!(
+                "| {n} | {r:.3} | {d:.3} | {:.2} | {e:.3} | {:.2} |",
+                d / r,
+                e / r
+            );
+            total[0] += r;
+            total[1] += d;
+            total[2] += e;
+        }
+        println!(
+            "| the frame | {:.2} | {:.2} | {:.2} | {:.2} | {:.2} |",
+            total[0],
+            total[1],
+            total[1] / total[0],
+            total[2],
+            total[2] / total[0]
+        );
+        println!(
+            "\nAnswers differing from raylane's over all frames (hit or miss; `t` beyond 10^-3 relative plus 2^-18 of the origin's largest coordinate over `|d|`; the bullet's instance):\n"
+        );
+        for (n, d, e) in &self.differ {
+            println!("* {n}: {d} (dynamic), {e} (default)");
+        }
     }
 }
