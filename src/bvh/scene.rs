@@ -442,7 +442,7 @@ pub(crate) fn instances<L: Lane, C: Collector<L>>(
 /// [`instances`] for one ray from the node reference `start` (0: the root; the one-ray
 /// traversal): `visit(i, c)` per instance reached whose own world box the ray's interval
 /// meets (the nodes' slab test on the leaf's four boxes, made at the first leaf: a pure
-/// prune), in the leaf's order.
+/// prune), nearest entry first.
 #[inline(always)]
 pub(crate) fn instances_one<C: Collector<f32>>(
     top: &Bvh<'_, Inst4>,
@@ -458,10 +458,23 @@ pub(crate) fn instances_one<C: Collector<f32>>(
         };
         let slab = slab.get_or_insert_with(|| Slab::new(ray.origin(), ray.dir(), top.reach));
         let boxes = leaf.bounds.map(f32x4::new);
-        let (mut bits, _) = slab.test4(&boxes, &leaf.index, ray.t_min(), c.t_max());
+        let (mut bits, tn) = slab.test4(&boxes, &leaf.index, ray.t_min(), c.t_max());
         while bits != 0 {
-            let k = bits.trailing_zeros() as usize;
-            bits &= bits - 1;
+            // The nearest entry first; an instance entered beyond a closest hit found since
+            // the test is skipped.
+            let mut k = bits.trailing_zeros() as usize;
+            let mut rest = bits & (bits - 1);
+            while rest != 0 {
+                let j = rest.trailing_zeros() as usize;
+                rest &= rest - 1;
+                if tn[j] < tn[k] {
+                    k = j;
+                }
+            }
+            bits &= !(1 << k);
+            if C::SHRINKS && tn[k] > c.t_max() {
+                continue;
+            }
             if visit(leaf.index[k], c) {
                 return true;
             }
