@@ -141,7 +141,7 @@ mod traverse;
 pub use leaf::{Leaf, Packed, Primitives, Sphere4, Tri4};
 pub use node::{Layout, Node, Node4};
 #[cfg(feature = "alloc")]
-pub use owned_scene::{Commit, InstanceId, Object, ObjectId, OwnedScene, SceneError};
+pub use owned_scene::{Commit, InstanceId, Object, ObjectId, OwnedScene, SceneError, WithKernels};
 pub use scene::{Inst4, Instance, Scene};
 
 use wide::f32x4;

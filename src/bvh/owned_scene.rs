@@ -3,8 +3,9 @@
 //! handles, each with a 32-bit layer mask, and one commit per frame that refits or rebuilds the
 //! top level only. Queries run between commits, on any number of threads (`&OwnedScene` is
 //! `Sync`: nothing changes while it is shared), through the one vocabulary
-//! ([`Query`](crate::Query)), with layer masks and hit filters through
-//! [`Filtered`] ([`masked`](OwnedScene::masked), [`filtered`](OwnedScene::filtered)).
+//! ([`Query`](crate::Query)), with layer masks, an ignored instance and hit filters through
+//! [`Filtered`] ([`masked`](OwnedScene::masked), [`ignoring`](OwnedScene::ignoring),
+//! [`filtered`](OwnedScene::filtered)).
 //!
 //! ```
 //! use raylane::bvh::{OwnedBvh, OwnedScene};
@@ -51,9 +52,9 @@
 //!
 //! **Frames.** Changes ([`add`](OwnedScene::add), [`remove`](OwnedScene::remove),
 //! [`set_transform`](OwnedScene::set_transform), [`set_mask`](OwnedScene::set_mask)) are
-//! staged; queries see the scene as of the last [`commit`](OwnedScene::commit), which moves the
-//! staged changes in (the changed instances' inverse transforms and world boxes) and then
-//! refits or rebuilds the top level, never an object:
+//! staged (a transform's inverse is made when it is set); queries see the scene as of the last
+//! [`commit`](OwnedScene::commit), which moves the staged changes in (the changed instances'
+//! world boxes) and then refits or rebuilds the top level, never an object:
 //!
 //! * **Rebuild** (binned SAH over the instances' world boxes, as the caller-storage
 //!   [`Scene`](super::Scene) is built) when the number of slots changed (an `add` past the
@@ -63,16 +64,18 @@
 //!   otherwise — also after removals and after adds into freed slots (a free slot is an
 //!   instance with an empty box).
 //!
-//! The rule was chosen by measurement (`examples/game.rs`, 10,000 instances moving every
-//! frame, and `docs/design.md`): see [`REBUILD_RATIO`].
+//! The rule was chosen by measurement (`examples/game`, 10,000 instances moving every frame):
+//! see [`REBUILD_RATIO`]; an engine may set its own ([`OwnedScene::set_rebuild_ratio`]).
 //!
 //! **Answers.** Those of the caller-storage [`Scene`](super::Scene): the closest hit over
 //! every instance's object with its default kernel (triangles
-//! [`Watertight`](crate::triangle::Watertight), spheres [`Robust`](crate::sphere::Robust),
+//! [`Watertight`], spheres [`Robust`],
 //! two-sided), ties to the lower slot, then the lower primitive; the record in world space.
 //! Layers: an instance is seen by a ray only when their masks share a bit (a query without a
-//! mask has every bit, so an instance whose mask is 0 is never seen); masks live at instances
-//! (an object is one layer; split it into objects for more). Bad input:
+//! mask has every bit, so an instance whose mask is 0 is never seen) and the ray does not
+//! ignore it ([`ignoring`](OwnedScene::ignoring)); a lane that does not see an instance does
+//! not trace it. Masks live at instances (an object is one layer; split it into objects for
+//! more): per-primitive masks would widen every leaf for every query. Bad input:
 //!
 //! * a removed or stale handle: [`SceneError::Stale`], nothing changes;
 //! * a NaN or infinite transform (or one whose inverse is not finite: a singular one): the
@@ -82,31 +85,43 @@
 //! * an empty scene, or one emptied during a frame: every query misses once committed.
 
 use alloc::vec::Vec;
+use core::marker::PhantomData;
 
 use super::scene::{
     instance_records, instances, instances_one, object_packet, object_ray, world_record,
 };
 use super::{Inst4, Instance, OwnedBvh, Primitives, Sphere4, Stats, Tri4, build, split};
 use crate::hit::{Candidate, Collector, Hit, Hits, Winners, alone};
-use crate::kernel::Cull;
+use crate::kernel::{Cull, Kernel};
 use crate::lane::{Lane, Mask};
 use crate::ray::{Ray, RayPacket};
 use crate::set::{Filtered, Set, Trace, only};
+use crate::sphere::{Robust, Sphere};
+use crate::triangle::{Triangle, Watertight};
 
 /// The factor of SAH cost over the cost at the last rebuild beyond which a commit rebuilds
 /// the top level instead of refitting it.
 ///
-/// Measured with `examples/game.rs` (10,000 instances of 6 objects moving every frame,
-/// single thread): see `docs/design.md`, "An engine's scene".
-pub const REBUILD_RATIO: f64 = 1.5;
+/// Measured with `examples/game` (10,000 instances of 7 objects, all moving every frame; one
+/// thread; `--speed 3`: frames of 1/20 s): a rebuild costs 3–4 ms against a refit's 0.4–0.6
+/// ms, and the frame's queries (about 10 ms: a pick, 1,000 sight lines, 10,000 bullets, a
+/// shadow ray per impact) cost about half the SAH ratio's excess more on a refitted tree
+/// (ratio 1.08: +1.5 %; 1.21: +12 %; 1.57: +21 %; 2.4: +98 %). Rebuilding every `N` frames
+/// while the loss grows by `g` per frame costs `R/N + g·N/2` per frame on average, least when
+/// the loss at the rebuild is `√(2·R·g)`: about 0.3–0.45 ms here, a ratio of 1.08–1.1. Over
+/// 200 frames (two runs) the mean frame took 11.9 and 12.8 ms at 1.1 (6 rebuilds), 12.8 and
+/// 11.9 at 1.2 (4), 12.7 and 13.1 at 1.05 (8), 14.1 and 13.3 at 1.5 (2), 18.5 and 16.3
+/// refitting only, 19.1 and 15.5 rebuilding every frame. See `docs/design.md`, "An engine's
+/// scene".
+pub const REBUILD_RATIO: f64 = 1.1;
 
 /// An object of an [`OwnedScene`]: a BVH over a triangle mesh or over spheres, built once and
 /// shared by any number of instances.
 #[derive(Clone, Debug)]
 pub enum Object {
-    /// Triangles ([`Watertight`](crate::triangle::Watertight), two-sided).
+    /// Triangles ([`Watertight`], two-sided).
     Mesh(OwnedBvh<Tri4>),
-    /// Spheres ([`Robust`](crate::sphere::Robust)).
+    /// Spheres ([`Robust`]).
     Spheres(OwnedBvh<Sphere4>),
 }
 
@@ -133,27 +148,39 @@ impl Object {
     }
 
     #[inline(always)]
-    fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
+    fn trace<T: Kernel<Triangle>, S: Kernel<Sphere>, L: Lane, C: Collector<L>>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
         match self {
-            Object::Mesh(t) => Trace::trace(t, rays, set, c),
-            Object::Spheres(t) => Trace::trace(t, rays, set, c),
+            Object::Mesh(t) => t.trace_with::<T, L, C>(cull, rays, set, c),
+            Object::Spheres(t) => t.trace_with::<S, L, C>(cull, rays, set, c),
         }
     }
 
     #[inline(always)]
-    fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
+    fn trace_ray<T: Kernel<Triangle>, S: Kernel<Sphere>, C: Collector<f32>>(
+        &self,
+        cull: Cull,
+        ray: &Ray,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
         match self {
-            Object::Mesh(t) => Trace::trace_ray(t, ray, set, c),
-            Object::Spheres(t) => Trace::trace_ray(t, ray, set, c),
+            Object::Mesh(t) => t.trace_ray_with::<T, C>(cull, ray, set, c),
+            Object::Spheres(t) => t.trace_ray_with::<S, C>(cull, ray, set, c),
         }
     }
 
     /// The record of the winner `one` (set 0) of the object-space ray `local`.
-    fn record(&self, local: &Ray, one: &Winners<f32>) -> Option<Hit> {
+    fn record(&self, cull: Cull, local: &Ray, one: &Winners<f32>) -> Option<Hit> {
         let rays = RayPacket::splat(local);
         match self {
-            Object::Mesh(t) => t.records_with(Cull::None, &rays, 0, one).lane(0),
-            Object::Spheres(t) => t.records_with(Cull::None, &rays, 0, one).lane(0),
+            Object::Mesh(t) => t.records_with(cull, &rays, 0, one).lane(0),
+            Object::Spheres(t) => t.records_with(cull, &rays, 0, one).lane(0),
         }
     }
 }
@@ -600,15 +627,101 @@ impl OwnedScene {
         Commit::Rebuild
     }
 
+    /// This scene with the triangle kernel `T` and the sphere kernel `S` instead of
+    /// [`Watertight`] and [`Robust`] (any [`Kernel`] of each primitive, e.g.
+    /// [`Moller`](crate::triangle::Moller), Embree's method), queried like the scene itself;
+    /// [`culled`](WithKernels::culled) drops back faces.
+    #[must_use]
+    pub fn with_kernels<T: Kernel<Triangle>, S: Kernel<Sphere>>(&self) -> WithKernels<'_, T, S> {
+        WithKernels {
+            scene: self,
+            cull: Cull::None,
+            kernels: PhantomData,
+        }
+    }
+
+    /// The packet query with kernels `T`, `S` and culling `cull`.
+    fn trace_with<T: Kernel<Triangle>, S: Kernel<Sphere>, L: Lane, C: Collector<L>>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        instances(
+            &self.top.view(),
+            rays,
+            c,
+            |i, r, c| {
+                let Some((p, object)) = self.placed(i) else {
+                    return false;
+                };
+                let keep = c.sees(set + i, p.mask);
+                if keep.none() {
+                    return false;
+                }
+                let local = object_packet(&p.to_object, r);
+                if keep.all() {
+                    object.trace::<T, S, L, C>(cull, &local, set + i, c)
+                } else {
+                    object.trace::<T, S, L, C>(cull, &only(&local, keep), set + i, c)
+                }
+            },
+            split::<L, C>(),
+            |start, i, c| {
+                alone(c, i, |one| {
+                    self.trace_from::<T, S, _>(cull, start, &rays.lane_ray(i), set, one)
+                })
+            },
+        )
+    }
+
+    /// The one-ray query with kernels `T`, `S` and culling `cull`.
+    fn trace_ray_with<T: Kernel<Triangle>, S: Kernel<Sphere>, C: Collector<f32>>(
+        &self,
+        cull: Cull,
+        ray: &Ray,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
+        if C::EVERY {
+            return self.trace_with::<T, S, f32, C>(cull, &RayPacket::splat(ray), set, c);
+        }
+        self.trace_from::<T, S, C>(cull, 0, ray, set, c)
+    }
+
     /// One ray from the top level's node reference `start` (0: the root): the one-ray query,
     /// and a packet's lanes that continue alone.
     #[inline(always)]
-    fn trace_from<C: Collector<f32>>(&self, start: u32, ray: &Ray, set: u32, c: &mut C) -> bool {
+    fn trace_from<T: Kernel<Triangle>, S: Kernel<Sphere>, C: Collector<f32>>(
+        &self,
+        cull: Cull,
+        start: u32,
+        ray: &Ray,
+        set: u32,
+        c: &mut C,
+    ) -> bool {
         instances_one(&self.top.view(), ray, start, c, |i, c| {
             let Some((p, object)) = self.placed(i) else {
                 return false;
             };
-            c.sees(set + i, p.mask) && object.trace_ray(&object_ray(&p.to_object, ray), set + i, c)
+            let local = || object_ray(&p.to_object, ray);
+            c.sees(set + i, p.mask) && object.trace_ray::<T, S, C>(cull, &local(), set + i, c)
+        })
+    }
+
+    /// The records of the winners `w` of a query culled by `cull`.
+    fn records_with<L: Lane>(
+        &self,
+        cull: Cull,
+        rays: &RayPacket<L>,
+        set: u32,
+        w: &Winners<L>,
+    ) -> Hits<L> {
+        instance_records(rays, set, Trace::sets(self), w, |i, ray, one| {
+            let (p, object) = self.placed(i)?;
+            let h = object.record(cull, &object_ray(&p.to_object, ray), one)?;
+            Some(world_record(&p.to_object, p.mirror, set + i, ray, h))
         })
     }
 
@@ -631,55 +744,74 @@ fn empty_top() -> OwnedBvh<Inst4> {
 
 /// An owned scene answers like the caller-storage [`Scene`](super::Scene) over its visible
 /// instances (see the [module docs](self)); the top level's leaves are instances, traversed by
-/// the one traversal, and a packet's lanes that do not see an instance (its mask) trace past it
-/// with an empty interval.
+/// the one traversal, and a packet's lanes that do not see an instance (its mask, an ignored
+/// instance) trace past it with an empty interval.
 impl Trace for OwnedScene {
     #[inline]
     fn sets(&self) -> u32 {
         self.placed.len() as u32
     }
 
+    #[inline]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
-        instances(
-            &self.top.view(),
-            rays,
-            c,
-            |i, r, c| {
-                let Some((p, object)) = self.placed(i) else {
-                    return false;
-                };
-                let keep = c.sees(set + i, p.mask);
-                if keep.none() {
-                    return false;
-                }
-                let local = object_packet(&p.to_object, r);
-                if keep.all() {
-                    object.trace(&local, set + i, c)
-                } else {
-                    object.trace(&only(&local, keep), set + i, c)
-                }
-            },
-            split::<L, C>(),
-            |start, i, c| {
-                alone(c, i, |one| {
-                    self.trace_from(start, &rays.lane_ray(i), set, one)
-                })
-            },
-        )
+        self.trace_with::<Watertight, Robust, L, C>(Cull::None, rays, set, c)
     }
 
+    #[inline]
     fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
-        if C::EVERY {
-            return self.trace(&RayPacket::<f32>::splat(ray), set, c);
-        }
-        self.trace_from(0, ray, set, c)
+        self.trace_ray_with::<Watertight, Robust, C>(Cull::None, ray, set, c)
     }
 
+    #[inline]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
-        instance_records(rays, set, self.sets(), w, |i, ray, one| {
-            let (p, object) = self.placed(i)?;
-            let h = object.record(&object_ray(&p.to_object, ray), one)?;
-            Some(world_record(&p.to_object, p.mirror, set + i, ray, h))
-        })
+        self.records_with(Cull::None, rays, set, w)
+    }
+}
+
+/// An [`OwnedScene`] with other kernels and culling ([`OwnedScene::with_kernels`]), queried
+/// like the scene itself (also through [`Filtered`]).
+#[derive(Debug)]
+pub struct WithKernels<'a, T, S> {
+    scene: &'a OwnedScene,
+    cull: Cull,
+    kernels: PhantomData<(T, S)>,
+}
+
+impl<T, S> Clone for WithKernels<'_, T, S> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T, S> Copy for WithKernels<'_, T, S> {}
+
+impl<T, S> WithKernels<'_, T, S> {
+    /// The same query culled ([`Cull::Back`]: front faces only, as a set's
+    /// [`culled`](crate::Query::culled)).
+    #[must_use]
+    pub fn culled(self, cull: Cull) -> Self {
+        WithKernels { cull, ..self }
+    }
+}
+
+impl<T: Kernel<Triangle>, S: Kernel<Sphere>> Trace for WithKernels<'_, T, S> {
+    #[inline]
+    fn sets(&self) -> u32 {
+        Trace::sets(self.scene)
+    }
+
+    #[inline]
+    fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
+        self.scene.trace_with::<T, S, L, C>(self.cull, rays, set, c)
+    }
+
+    #[inline]
+    fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
+        self.scene.trace_ray_with::<T, S, C>(self.cull, ray, set, c)
+    }
+
+    #[inline]
+    fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
+        self.scene.records_with(self.cull, rays, set, w)
     }
 }

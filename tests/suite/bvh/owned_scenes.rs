@@ -30,6 +30,9 @@ enum Flat {
 
 type Rows = [[f32; 4]; 3];
 
+/// Every hit of a flat set of `P` for a ray, passed to a callback (a kernel and culling).
+type Every<'a, P> = &'a dyn Fn(&[P], &Ray, &mut dyn FnMut(Hit));
+
 /// The scene and a model of it: per slot, the committed `(object, transform, mask)`.
 struct World {
     flats: Vec<Flat>,
@@ -111,8 +114,23 @@ impl World {
     fn brute_ignoring(
         &self,
         r: &Ray,
+        sight: (u32, u32),
+        keep: &dyn Fn(&Candidate) -> bool,
+    ) -> Want {
+        self.brute_with(r, sight, keep, &|t, l, f| t.all(l, f), &|b, l, f| {
+            b.all(l, f)
+        })
+    }
+
+    /// Brute force as [`brute_ignoring`](Self::brute_ignoring) with the triangles' and
+    /// spheres' every hit from `tris` and `balls` (another kernel, culling).
+    fn brute_with(
+        &self,
+        r: &Ray,
         (mask, ignored): (u32, u32),
         keep: &dyn Fn(&Candidate) -> bool,
+        tris: Every<'_, Triangle>,
+        balls: Every<'_, Sphere>,
     ) -> Want {
         let mut kept = Vec::new();
         let mut best: Option<Hit> = None;
@@ -143,8 +161,8 @@ impl World {
                 }
             };
             match &self.flats[object as usize] {
-                Flat::Tris(t) => t[..].all(&local, |h| visit(h, false)),
-                Flat::Balls(b) => b[..].all(&local, |h| visit(h, true)),
+                Flat::Tris(t) => tris(t, &local, &mut |h| visit(h, false)),
+                Flat::Balls(b) => balls(b, &local, &mut |h| visit(h, true)),
             }
         }
         kept.sort_unstable();
@@ -598,4 +616,60 @@ fn rejected_hits_do_not_shrink_the_interval() {
     for (i, r) in rays.iter().enumerate() {
         assert_eq!(bits(scene.closest(r)), bits(one[i]), "ray {i}");
     }
+}
+
+/// Other kernels and culling (`with_kernels`): the default pair is the scene itself; Möller
+/// with back faces culled equals brute force with the same kernel and culling, with masks,
+/// ignored instances and filters, at every width.
+#[test]
+fn other_kernels_and_culling() {
+    use raylane::Cull;
+    use raylane::sphere::Robust;
+    use raylane::triangle::{Moller, Watertight};
+    let mut rng = SmallRng::seed_from_u64(306);
+    let mut world = new_world(&mut rng);
+    for i in 0..40u32 {
+        world.add(
+            i % 3,
+            place(&mut rng, 8.0),
+            LAYERS[i as usize % LAYERS.len()],
+        );
+    }
+    world.commit();
+    let rays = shots(&mut rng, &world, 150);
+    let same = world.scene.with_kernels::<Watertight, Robust>();
+    for r in &rays {
+        assert_eq!(bits(same.closest(r)), bits(world.scene.closest(r)));
+    }
+    let moller = world
+        .scene
+        .with_kernels::<Moller, Robust>()
+        .culled(Cull::Back);
+    let mut hits = 0;
+    for (name, f) in filters() {
+        let f = &*f;
+        let want: Vec<Want> = rays
+            .iter()
+            .enumerate()
+            .map(|(i, r)| {
+                world.brute_with(
+                    r,
+                    sight_of(i),
+                    f,
+                    &|t, l, g| t.using::<Moller>().culled(Cull::Back).all(l, g),
+                    &|b, l, g| b.culled(Cull::Back).all(l, g),
+                )
+            })
+            .collect();
+        let got = check_against(
+            &|m, i| Filtered::new(&moller).masks(m).ignores(i).filter(f),
+            &rays,
+            &want,
+            &sight_of,
+            false,
+        );
+        assert!(name == "nothing" || got > 5, "{name}: {got}");
+        hits += got;
+    }
+    assert!(hits > 100, "{hits}");
 }
