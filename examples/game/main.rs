@@ -16,11 +16,12 @@
 //!
 //! ```sh
 //! cargo run --release --example game [-- --frames N] [--instances N]
-//!     [--rebuild auto|always|never] [--packets] [--filter]
+//!     [--rebuild auto|always|never|RATIO] [--packets] [--filter] [--speed N]
 //! ```
 //!
 //! `--rebuild` picks the commit's rule (the default, `auto`, is `OwnedScene`'s: refit until
-//! the tree's SAH cost passes 1.5× its cost at the last rebuild); `--packets` traces bullets
+//! the tree's SAH cost passes `REBUILD_RATIO` times its cost at the last rebuild; a number
+//! sets another ratio); `--packets` traces bullets
 //! and sight lines in packets of 8 (each lane ignoring its own shooter); `--speed N` runs the
 //! game N times faster (frames of N/60 s: the long run of a refitted tree, in few frames).
 
@@ -67,12 +68,13 @@ fn opts() -> Opts {
                 o.rebuild = match args.next().as_deref() {
                     Some("always") => 0.0,
                     Some("never") => f64::INFINITY,
-                    _ => o.rebuild,
+                    Some(x) => x.parse().unwrap_or(o.rebuild),
+                    None => o.rebuild,
                 }
             }
             _ => {
                 eprintln!(
-                    "usage: game [--frames N] [--instances N] [--rebuild auto|always|never] [--packets] [--filter] [--speed N]"
+                    "usage: game [--frames N] [--instances N] [--rebuild auto|always|never|RATIO] [--packets] [--filter] [--speed N]"
                 );
                 std::process::exit(2);
             }
@@ -239,8 +241,9 @@ fn main() {
         rows.push([stage, commit, pick, sight, bullets, shadows]);
     }
     let col = |k: usize| median(rows.iter().map(|r| r[k]).collect());
+    let mean = rows.iter().map(|r| r.iter().sum::<f64>()).sum::<f64>() / rows.len() as f64;
     println!(
-        "\nmedian ms over {} frames: stage {:.2}, commit {:.2} ({} refits, {} rebuilds), pick {:.3}, sight lines {:.2}, bullets {:.2}, shadows {:.2}; frame {:.1}",
+        "\nmedian ms over {} frames: stage {:.2}, commit {:.2} ({} refits, {} rebuilds), pick {:.3}, sight lines {:.2}, bullets {:.2}, shadows {:.2}; frame {:.1} (mean {mean:.1})",
         rows.len(),
         col(0),
         col(1),
