@@ -338,7 +338,7 @@ macro_rules! portable {
 }
 
 portable!(
-    /// Eight `f32` lanes (see the [module docs](self)).
+    /// Eight `f32` lanes (see the module docs of `lane::portable`).
     X8,
     8,
     32
