@@ -95,17 +95,10 @@ step "MSRV: the library built and tested with Rust $msrv"
 for f in "" alloc std; do
   cargo "+$msrv" build --quiet --lib --no-default-features ${f:+--features "$f"} --target-dir target/msrv
 done
-# The library's own tests and doctests, and the two programs a user would write (the render,
-# the game's frame), at the MSRV. The suite (tests/suite) runs on stable only: Rust 1.89
-# needs more than 12 GB to compile that one binary (every query at every SIMD level; stable
-# compiles it in minutes), so the MSRV is promised for the library, not for our test binary.
-{ cargo "+$msrv" test --quiet -p raylane --target-dir target/msrv --lib \
-    && cargo "+$msrv" test --quiet -p raylane --target-dir target/msrv --doc \
-    && cargo "+$msrv" build --quiet --release -p raylane --target-dir target/msrv \
-      --example render --example game; } \
+cargo "+$msrv" test --quiet -p raylane --target-dir target/msrv \
   > target/msrv.log 2>&1 || { cat target/msrv.log; fail "the tests fail with Rust $msrv"; }
 grep -E '^test result' target/msrv.log | sed "s/^/rust $msrv: /"
-echo "rust $msrv ($(rustc "+$msrv" --version)): the library builds with every feature, its unit and doc tests pass, the render and game examples build"
+echo "rust $msrv ($(rustc "+$msrv" --version)): the library builds with every feature and its tests pass"
 
 step "host test suite (x86-64, a default build: every SIMD level this CPU has, chosen at run time)"
 # The SIMD levels of this CPU (raylane::simd): the suite runs once at the best (detected) and
