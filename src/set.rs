@@ -346,25 +346,21 @@ impl<'a, T: ?Sized, F> Filtered<'a, T, F> {
 }
 
 impl<T: Trace + ?Sized, F: Filter> Trace for Filtered<'_, T, F> {
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn sets(&self) -> u32 {
         self.set.sets()
     }
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
         let mut screen = Screen::new(c, &self.sight, &self.filter);
         self.set.trace(rays, set, &mut screen)
     }
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
         let mut screen = Screen::new(c, &self.sight, &self.filter);
         self.set.trace_ray(ray, set, &mut screen)
     }
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
         self.set.records(rays, set, w)
     }

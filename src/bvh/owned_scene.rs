@@ -176,8 +176,6 @@ impl Object {
     }
 
     /// The record of the winner `one` (set 0) of the object-space ray `local`.
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn record(&self, cull: Cull, local: &Ray, one: &Winners<f32>) -> Option<Hit> {
         let rays = RayPacket::splat(local);
         match self {
@@ -643,8 +641,6 @@ impl OwnedScene {
     }
 
     /// The packet query with kernels `T`, `S` and culling `cull`.
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_with<T: Kernel<Triangle>, S: Kernel<Sphere>, L: Lane, C: Collector<L>>(
         &self,
         cull: Cull,
@@ -681,8 +677,6 @@ impl OwnedScene {
     }
 
     /// The one-ray query with kernels `T`, `S` and culling `cull`.
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray_with<T: Kernel<Triangle>, S: Kernel<Sphere>, C: Collector<f32>>(
         &self,
         cull: Cull,
@@ -717,8 +711,6 @@ impl OwnedScene {
     }
 
     /// The records of the winners `w` of a query culled by `cull`.
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,
@@ -755,26 +747,22 @@ fn empty_top() -> OwnedBvh<Inst4> {
 /// the one traversal, and a packet's lanes that do not see an instance (its mask, an ignored
 /// instance) trace past it with an empty interval.
 impl Trace for OwnedScene {
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn sets(&self) -> u32 {
         self.placed.len() as u32
     }
 
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
         self.trace_with::<Watertight, Robust, L, C>(Cull::None, rays, set, c)
     }
 
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
         self.trace_ray_with::<Watertight, Robust, C>(Cull::None, ray, set, c)
     }
 
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
         self.records_with(Cull::None, rays, set, w)
     }
@@ -807,26 +795,22 @@ impl<T, S> WithKernels<'_, T, S> {
 }
 
 impl<T: Kernel<Triangle>, S: Kernel<Sphere>> Trace for WithKernels<'_, T, S> {
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn sets(&self) -> u32 {
         Trace::sets(self.scene)
     }
 
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
         self.scene.trace_with::<T, S, L, C>(self.cull, rays, set, c)
     }
 
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
         self.scene.trace_ray_with::<T, S, C>(self.cull, ray, set, c)
     }
 
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    #[inline]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
         self.scene.records_with(self.cull, rays, set, w)
     }

@@ -342,8 +342,6 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         self.instances.len() as u32
     }
 
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_with<K: Kernel<P::Prim>, L: Lane, C: Collector<L>>(
         &self,
         cull: Cull,
@@ -367,8 +365,6 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         )
     }
 
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
         &self,
         cull: Cull,
@@ -388,8 +384,6 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         })
     }
 
-    #[cfg_attr(target_arch = "x86_64", inline(always))]
-    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,
