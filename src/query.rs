@@ -266,8 +266,8 @@ impl<L: Lane> Rays for RayPacket<L> {
                 hits_out(&closest_packet(self.0, &packet_in::<L, M>(self.1)))
             }
         }
-        if L::PLAIN_F32 {
-            simd::with_lanes(L::LANES, Q(t, rays))
+        if const { L::PLAIN_F32 } {
+            simd::with_lanes_of::<L, _>(Q(t, rays))
         } else {
             closest_packet(t, rays)
         }
@@ -283,8 +283,8 @@ impl<L: Lane> Rays for RayPacket<L> {
                 L::Mask::from_bits(any_packet(self.0, &packet_in::<L, M>(self.1)).bits())
             }
         }
-        if L::PLAIN_F32 {
-            simd::with_lanes(L::LANES, Q(t, rays))
+        if const { L::PLAIN_F32 } {
+            simd::with_lanes_of::<L, _>(Q(t, rays))
         } else {
             any_packet(t, rays)
         }
@@ -308,8 +308,8 @@ impl<L: Lane> Rays for RayPacket<L> {
                 self.0.trace(&r, 0, &mut c);
             }
         }
-        if L::PLAIN_F32 {
-            simd::with_lanes(L::LANES, Q(t, rays, f, core::marker::PhantomData))
+        if const { L::PLAIN_F32 } {
+            simd::with_lanes_of::<L, _>(Q(t, rays, f, core::marker::PhantomData))
         } else {
             let mut c = All::new(rays, |h: &Hits<L>| f(*h));
             t.trace(rays, 0, &mut c);
@@ -347,7 +347,7 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
                 out
             }
         }
-        simd::with_lanes(L::LANES, Q(t, tile))
+        simd::with_lanes_of::<L, _>(Q(t, tile))
     }
 
     #[inline]
@@ -373,7 +373,7 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
                 out
             }
         }
-        simd::with_lanes(L::LANES, Q(t, tile))
+        simd::with_lanes_of::<L, _>(Q(t, tile))
     }
 
     #[inline]
@@ -405,6 +405,6 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
                 }
             }
         }
-        simd::with_lanes(L::LANES, Q(t, tile, f))
+        simd::with_lanes_of::<L, _>(Q(t, tile, f))
     }
 }

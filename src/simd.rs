@@ -228,17 +228,33 @@ pub trait Packets {
 /// `#[inline(always)]` down to its loops, like the crate's query paths (see [`run`]).
 #[inline(always)]
 pub fn with_lanes<F: Packets>(lanes: usize, f: F) -> F::Output {
+    match lanes {
+        1 => with_lanes_of::<f32, F>(f),
+        4 => with_lanes_of::<wide::f32x4, F>(f),
+        8 => with_lanes_of::<wide::f32x8, F>(f),
+        _ => with_lanes_of::<wide::f32x16, F>(f),
+    }
+}
+
+/// [`with_lanes`] for packets of `L`'s width, a constant: only that width's copies are
+/// compiled (one per level), where a width known at run time compiles every width's (the
+/// queries enter here; their packets' width is their type's).
+#[inline(always)]
+pub(crate) fn with_lanes_of<L: Lane, F: Packets>(f: F) -> F::Output {
     #[cfg(target_arch = "x86_64")]
     {
-        x86::with_lanes(level(), lanes, f)
+        x86::with_lanes_of::<L, F>(level(), f)
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
-        match lanes {
-            1 => f.run::<f32>(),
-            4 => f.run::<wide::f32x4>(),
-            8 => f.run::<wide::f32x8>(),
-            _ => f.run::<wide::f32x16>(),
+        if const { L::LANES == 1 } {
+            f.run::<f32>()
+        } else if const { L::LANES == 4 } {
+            f.run::<wide::f32x4>()
+        } else if const { L::LANES == 8 } {
+            f.run::<wide::f32x8>()
+        } else {
+            f.run::<wide::f32x16>()
         }
     }
 }
@@ -246,41 +262,75 @@ pub fn with_lanes<F: Packets>(lanes: usize, f: F) -> F::Output {
 #[cfg(target_arch = "x86_64")]
 mod x86 {
     use super::{Level, Packets};
+    use crate::lane::Lane;
     use crate::lane::{Y8, Y16, Z16};
 
-    /// [`super::with_lanes`] at `level`.
+    /// [`super::with_lanes_of`] at `level`. The width is a constant (`if const`): the other
+    /// widths' branches are not compiled, so a query has three copies (one per level).
     #[inline(always)]
-    pub(super) fn with_lanes<F: Packets>(level: Level, lanes: usize, f: F) -> F::Output {
-        match (level, lanes) {
-            (_, 1) => run(
+    pub(super) fn with_lanes_of<L: Lane, F: Packets>(level: Level, f: F) -> F::Output {
+        if const { L::LANES == 1 } {
+            run(
                 level,
                 #[inline(always)]
                 || f.run::<f32>(),
-            ),
-            (_, 4) => run(
+            )
+        } else if const { L::LANES == 4 } {
+            run(
                 level,
                 #[inline(always)]
                 || f.run::<wide::f32x4>(),
-            ),
-            (Level::Baseline, 8) => f.run::<wide::f32x8>(),
-            (Level::Baseline, _) => f.run::<wide::f32x16>(),
+            )
+        } else if const { L::LANES == 8 } {
             // Avx2 and Avx512 only where `best()` found them (`force` refuses more): the AVX
             // types' instructions exist on this CPU.
-            (_, 8) => run(
-                level,
-                #[inline(always)]
-                || f.run::<Y8>(),
-            ),
-            (Level::Avx2, _) => run(
-                level,
-                #[inline(always)]
-                || f.run::<Y16>(),
-            ),
-            (Level::Avx512, _) => run(
-                level,
-                #[inline(always)]
-                || f.run::<Z16>(),
-            ),
+            match level {
+                Level::Baseline => f.run::<wide::f32x8>(),
+                Level::Avx2 => at_v3(
+                    #[inline(always)]
+                    || f.run::<Y8>(),
+                ),
+                Level::Avx512 => at_v4(
+                    #[inline(always)]
+                    || f.run::<Y8>(),
+                ),
+            }
+        } else {
+            match level {
+                Level::Baseline => f.run::<wide::f32x16>(),
+                Level::Avx2 => at_v3(
+                    #[inline(always)]
+                    || f.run::<Y16>(),
+                ),
+                Level::Avx512 => at_v4(
+                    #[inline(always)]
+                    || f.run::<Z16>(),
+                ),
+            }
+        }
+    }
+
+    /// `f` in its x86-64-v3 copy; only at [`Level::Avx2`] or above.
+    #[inline(always)]
+    fn at_v3<R>(f: impl FnOnce() -> R) -> R {
+        if const { BUILT_V3 } {
+            f()
+        } else {
+            // SAFETY: called at `level()` Avx2 or Avx512 only, which `best()` returns when it
+            // found every v3 feature in `cpuid` and the OS saving the AVX state in XCR0.
+            unsafe { v3(f) }
+        }
+    }
+
+    /// `f` in its x86-64-v4 copy; only at [`Level::Avx512`].
+    #[inline(always)]
+    fn at_v4<R>(f: impl FnOnce() -> R) -> R {
+        if const { BUILT_V4 } {
+            f()
+        } else {
+            // SAFETY: called at `level()` Avx512 only, which `best()` returns when it found
+            // every v4 feature in `cpuid` and the OS saving the AVX-512 state in XCR0.
+            unsafe { v4(f) }
         }
     }
 
