@@ -41,50 +41,45 @@ pub struct K16(u16);
 // on the CPU, because a value of these types exists only there (see the module docs); loads
 // and stores access arrays of exactly the register's size.
 
+// `array` and `from_array` are bit casts, not the `storeu`/`loadu` intrinsics: those are
+// `#[inline]` functions the compiler left out of line inside a level's large copies (a call
+// per lane read: measured on the render's BVH primary rays at AVX-512).
 impl Y8 {
     #[inline(always)]
     fn array(self) -> [f32; 8] {
-        let mut a = [0.0f32; 8];
-        unsafe { _mm256_storeu_ps(a.as_mut_ptr(), self.0) };
-        a
+        // SAFETY: `__m256` and `[f32; 8]` are 32 bytes of plain data, every bit pattern valid.
+        unsafe { core::mem::transmute::<__m256, [f32; 8]>(self.0) }
     }
     #[inline(always)]
     fn from_array(a: [f32; 8]) -> Self {
-        Y8(unsafe { _mm256_loadu_ps(a.as_ptr()) })
+        // SAFETY: as above.
+        Y8(unsafe { core::mem::transmute::<[f32; 8], __m256>(a) })
     }
 }
 
 impl Y16 {
     #[inline(always)]
     fn array(self) -> [f32; 16] {
-        let mut a = [0.0f32; 16];
-        unsafe {
-            _mm256_storeu_ps(a.as_mut_ptr(), self.0[0]);
-            _mm256_storeu_ps(a.as_mut_ptr().add(8), self.0[1]);
-        }
-        a
+        // SAFETY: two `__m256` and `[f32; 16]` are 64 bytes of plain data.
+        unsafe { core::mem::transmute::<[__m256; 2], [f32; 16]>(self.0) }
     }
     #[inline(always)]
     fn from_array(a: [f32; 16]) -> Self {
-        unsafe {
-            Y16([
-                _mm256_loadu_ps(a.as_ptr()),
-                _mm256_loadu_ps(a.as_ptr().add(8)),
-            ])
-        }
+        // SAFETY: as above.
+        Y16(unsafe { core::mem::transmute::<[f32; 16], [__m256; 2]>(a) })
     }
 }
 
 impl Z16 {
     #[inline(always)]
     fn array(self) -> [f32; 16] {
-        let mut a = [0.0f32; 16];
-        unsafe { _mm512_storeu_ps(a.as_mut_ptr(), self.0) };
-        a
+        // SAFETY: `__m512` and `[f32; 16]` are 64 bytes of plain data.
+        unsafe { core::mem::transmute::<__m512, [f32; 16]>(self.0) }
     }
     #[inline(always)]
     fn from_array(a: [f32; 16]) -> Self {
-        Z16(unsafe { _mm512_loadu_ps(a.as_ptr()) })
+        // SAFETY: as above.
+        Z16(unsafe { core::mem::transmute::<[f32; 16], __m512>(a) })
     }
 }
 
