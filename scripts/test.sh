@@ -15,6 +15,7 @@
 #    time (raylane::simd; RAYLANE_SIMD forces the lower ones), the checker over every vector
 #    file with every method at every lane width, and the digests of every method and width at
 #    every level.
+#    Every level's copy checked for intrinsics left out of line (scripts/inline-check.sh).
 # 6. The host suite again built for x86-64-v3 (AVX2, FMA) and for the native CPU (AVX-512
 #    here); their digests must equal the baseline.
 # 7. Instructions per ray–primitive test of every kernel through the library's query, on
@@ -135,6 +136,14 @@ for method in $(./target/release/examples/check --list); do
 done
 printf '%-20s' "recommended"
 ./target/release/examples/check tests/vectors/*.txt | tail -n 1
+
+step "every SIMD level's copy inlined: no intrinsic called out of line on a hot path"
+# A function the compiler leaves out of line inside a level's copy runs without its level's
+# instructions (scripts/inline-check.sh): checked on the render and on the scenes benchmark
+# (every set, kernel and query kind it times), as users build them.
+cargo build --quiet --release -p raylane-bench --features peers --example scenes
+./scripts/inline-check.sh target/release/examples/render target/release/examples/scenes \
+  || fail "a hot path runs without its SIMD level's instructions"
 
 mkdir -p target/digests
 # Run times of the digest runs: "NAME SECONDS" lines.

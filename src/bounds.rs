@@ -202,7 +202,8 @@ impl Bound {
     /// False only in lanes whose ray line passes farther than `ρ = r + η(|C − o| + r)` from
     /// the centre, so that no triangle inside the sphere can report a hit: 17 mul, 16 add,
     /// 1 div, 4 cmp. Lanes whose `d·d` lies outside `2^-100…2^100` are never culled.
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     #[must_use]
     pub fn may_hit<L: Lane>(&self, rays: &RayPacket<L>) -> L::Mask {
         let d = rays.dir;
@@ -213,10 +214,11 @@ impl Bound {
         // 2. The perpendicular and its square against the padded, inflated radius.
         let l2 = (f - d.scale(s)).length_squared();
         let f2 = f.length_squared();
-        let limit = |k: usize| L::from_f32(self.r2[k]) + L::from_f32(self.kappa[k]) * f2;
+        let limit0 = L::from_f32(self.r2[0]) + L::from_f32(self.kappa[0]) * f2;
+        let limit1 = L::from_f32(self.r2[1]) + L::from_f32(self.kappa[1]) * f2;
         // 3. Directions outside the range where d·d is accurate are never culled.
         let scaled = dd.ge(L::from_f32(DD_LO)) & dd.le(L::from_f32(DD_HI));
-        !(l2.gt(limit(0)) | l2.gt(limit(1))) | !scaled
+        !(l2.gt(limit0) | l2.gt(limit1)) | !scaled
     }
 
     /// The sphere as a guarded focal cache entry for rays from `eye`, with the radius padded

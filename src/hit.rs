@@ -949,7 +949,10 @@ impl Record for Sphere {
             (if w.mask.test(i) { sphere(i) } else { None })
                 .unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN))
         };
-        let c = V3::<L>::from_fn(|i| get(i).center());
+        let c = V3::<L>::from_fn(
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |i| get(i).center(),
+        );
         let point = rays.origin.along(rays.dir, w.t);
         let n = unit(point - c, w.mask, |i| {
             let (o, d, c) = (
@@ -979,9 +982,10 @@ impl Record for Triangle {
         if w.mask.none() {
             return Hits::miss();
         }
-        let p = TrianglePacket::<L>::from_fn(|i| {
-            (if w.mask.test(i) { tri(i) } else { None }).unwrap_or(Triangle::never())
-        });
+        let p = TrianglePacket::<L>::from_fn(
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |i| (if w.mask.test(i) { tri(i) } else { None }).unwrap_or(Triangle::never()),
+        );
         let n = unit((p.b - p.a).cross(p.c - p.a), w.mask, |i| {
             let (a, b, c) = (
                 p.a.precise_lane(i),
@@ -1013,9 +1017,10 @@ impl Record for Plane {
         if w.mask.none() {
             return Hits::miss();
         }
-        let normal = V3::<L>::from_fn(|i| {
-            (if w.mask.test(i) { plane(i) } else { None }).map_or(Vec3::ZERO, |p| p.normal)
-        });
+        let normal = V3::<L>::from_fn(
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |i| (if w.mask.test(i) { plane(i) } else { None }).map_or(Vec3::ZERO, |p| p.normal),
+        );
         let n = unit(normal, w.mask, |i| normal.precise_lane(i));
         let point = rays.origin.along(rays.dir, w.t);
         let front = if cull.back() {

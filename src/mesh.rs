@@ -234,8 +234,12 @@ impl Set for Mesh<'_> {
         set: u32,
         w: &Winners<L>,
     ) -> Hits<L> {
-        Triangle::records(rays, &mine(w, set), cull, |i| {
-            Some(self.prepared(w.loc(i)? as usize))
-        })
+        Triangle::records(
+            rays,
+            &mine(w, set),
+            cull,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |i| Some(self.prepared(w.loc(i)? as usize)),
+        )
     }
 }

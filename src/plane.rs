@@ -72,8 +72,14 @@ impl<L: Lane> PlanePacket<L> {
                 .unwrap_or(Plane::new(Vec3::ZERO, Vec3::ZERO))
         };
         PlanePacket {
-            point: V3::from_fn(|i| get(i).point),
-            normal: V3::from_fn(|i| get(i).normal),
+            point: V3::from_fn(
+                #[cfg_attr(target_arch = "x86_64", inline(always))]
+                |i| get(i).point,
+            ),
+            normal: V3::from_fn(
+                #[cfg_attr(target_arch = "x86_64", inline(always))]
+                |i| get(i).normal,
+            ),
         }
     }
 }

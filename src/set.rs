@@ -346,21 +346,25 @@ impl<'a, T: ?Sized, F> Filtered<'a, T, F> {
 }
 
 impl<T: Trace + ?Sized, F: Filter> Trace for Filtered<'_, T, F> {
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
         self.set.sets()
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
         let mut screen = Screen::new(c, &self.sight, &self.filter);
         self.set.trace(rays, set, &mut screen)
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
         let mut screen = Screen::new(c, &self.sight, &self.filter);
         self.set.trace_ray(ray, set, &mut screen)
     }
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
         self.set.records(rays, set, w)
     }
@@ -549,9 +553,13 @@ impl Set for [Sphere] {
         set: u32,
         w: &Winners<L>,
     ) -> Hits<L> {
-        Sphere::records(rays, &mine(w, set), cull, |i| {
-            self.get(w.loc(i)? as usize).copied()
-        })
+        Sphere::records(
+            rays,
+            &mine(w, set),
+            cull,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |i| self.get(w.loc(i)? as usize).copied(),
+        )
     }
 }
 
@@ -579,9 +587,13 @@ impl Set for [Triangle] {
         set: u32,
         w: &Winners<L>,
     ) -> Hits<L> {
-        Triangle::records(rays, &mine(w, set), cull, |i| {
-            self.get(w.loc(i)? as usize).copied()
-        })
+        Triangle::records(
+            rays,
+            &mine(w, set),
+            cull,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |i| self.get(w.loc(i)? as usize).copied(),
+        )
     }
 }
 
@@ -609,9 +621,13 @@ impl Set for [Plane] {
         set: u32,
         w: &Winners<L>,
     ) -> Hits<L> {
-        Plane::records(rays, &mine(w, set), cull, |i| {
-            self.get(w.loc(i)? as usize).copied()
-        })
+        Plane::records(
+            rays,
+            &mine(w, set),
+            cull,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |i| self.get(w.loc(i)? as usize).copied(),
+        )
     }
 }
 

@@ -653,9 +653,12 @@ impl Set for Baked<'_> {
             split::<L, C>(),
             #[cfg_attr(target_arch = "x86_64", inline(always))]
             |start, i, c| {
-                alone(c, i, |one| {
-                    self.trace_from::<K, _>(cull, &rays.lane_ray(i), start, set, one)
-                })
+                alone(
+                    c,
+                    i,
+                    #[cfg_attr(target_arch = "x86_64", inline(always))]
+                    |one| self.trace_from::<K, _>(cull, &rays.lane_ray(i), start, set, one),
+                )
             },
         )
     }
@@ -687,9 +690,13 @@ impl Set for Baked<'_> {
         set: u32,
         w: &Winners<L>,
     ) -> Hits<L> {
-        Triangle::records(rays, &mine(w, set), cull, |i| {
-            Some(self.triangle(w.loc(i)? as usize))
-        })
+        Triangle::records(
+            rays,
+            &mine(w, set),
+            cull,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |i| Some(self.triangle(w.loc(i)? as usize)),
+        )
     }
 }
 

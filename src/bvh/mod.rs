@@ -695,9 +695,12 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
             split::<L, C>(),
             #[cfg_attr(target_arch = "x86_64", inline(always))]
             |start, i, c| {
-                alone(c, i, |one| {
-                    self.trace_from::<K, _>(cull, &rays.lane_ray(i), start, set, one)
-                })
+                alone(
+                    c,
+                    i,
+                    #[cfg_attr(target_arch = "x86_64", inline(always))]
+                    |one| self.trace_from::<K, _>(cull, &rays.lane_ray(i), start, set, one),
+                )
             },
         )
     }
@@ -729,10 +732,16 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
         set: u32,
         w: &Winners<L>,
     ) -> Hits<L> {
-        P::Prim::records(rays, &mine(w, set), cull, |i| {
-            let loc = w.loc(i)? as usize;
-            Some(self.leaves.get(loc / LEAF_WIDTH)?.prim(loc % LEAF_WIDTH))
-        })
+        P::Prim::records(
+            rays,
+            &mine(w, set),
+            cull,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |i| {
+                let loc = w.loc(i)? as usize;
+                Some(self.leaves.get(loc / LEAF_WIDTH)?.prim(loc % LEAF_WIDTH))
+            },
+        )
     }
 }
 

@@ -645,13 +645,17 @@ impl<L: Lane> PacketSlab<L> {
         let m = span * L::from_f32(MARGIN);
         let (ov, dv) = ([o.x, o.y, o.z], [d.x, d.y, d.z]);
         let zero = L::from_f32(0.0);
-        let neg = dv.map(|x| (x + zero).lt(zero));
-        let inv = dv.map(|x| {
-            let i = L::from_f32(1.0) / (x + zero);
-            lmax(lmin(i, L::from_f32(INV_MAX)), L::from_f32(-INV_MAX))
-        });
-        let on = core::array::from_fn(|a| L::select(neg[a], ov[a] - m, ov[a] + m));
-        let of = core::array::from_fn(|a| L::select(neg[a], ov[a] + m, ov[a] - m));
+        // Per axis in a loop, not with `map` or `from_fn`: their closures may be left out of
+        // line, and so run without the target features of a level's copy.
+        let mut neg = [L::Mask::splat(false); 3];
+        let (mut inv, mut on, mut of) = ([zero; 3], [zero; 3], [zero; 3]);
+        for a in 0..3 {
+            neg[a] = (dv[a] + zero).lt(zero);
+            let i = L::from_f32(1.0) / (dv[a] + zero);
+            inv[a] = lmax(lmin(i, L::from_f32(INV_MAX)), L::from_f32(-INV_MAX));
+            on[a] = L::select(neg[a], ov[a] - m, ov[a] + m);
+            of[a] = L::select(neg[a], ov[a] + m, ov[a] - m);
+        }
         PacketSlab {
             neg,
             on,

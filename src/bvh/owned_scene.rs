@@ -669,9 +669,12 @@ impl OwnedScene {
             },
             split::<L, C>(),
             |start, i, c| {
-                alone(c, i, |one| {
-                    self.trace_from::<T, S, _>(cull, start, &rays.lane_ray(i), set, one)
-                })
+                alone(
+                    c,
+                    i,
+                    #[cfg_attr(target_arch = "x86_64", inline(always))]
+                    |one| self.trace_from::<T, S, _>(cull, start, &rays.lane_ray(i), set, one),
+                )
             },
         )
     }

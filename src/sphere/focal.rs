@@ -296,13 +296,19 @@ impl<L: Lane> FocalSphere<L> {
         let never = FocalSphere::<f32>::new(Vec3::ZERO, &Sphere::new(Vec3::ZERO, f32::NAN));
         let get = |i: usize| entries.get(i).copied().unwrap_or(never);
         FocalSphere {
-            t: V3::from_fn(|i| get(i).t.into()),
+            t: V3::from_fn(
+                #[cfg_attr(target_arch = "x86_64", inline(always))]
+                |i| get(i).t.into(),
+            ),
             k_lo: L::from_f32_fn(|i| get(i).k_lo),
             r2: L::from_f32_fn(|i| get(i).r2),
             l2_hit: L::from_f32_fn(|i| get(i).l2_hit),
             l2_miss: L::from_f32_fn(|i| get(i).l2_miss),
             t_acc: L::from_f32_fn(|i| get(i).t_acc),
-            center: V3::from_fn(|i| get(i).center.into()),
+            center: V3::from_fn(
+                #[cfg_attr(target_arch = "x86_64", inline(always))]
+                |i| get(i).center.into(),
+            ),
             radius: L::from_f32_fn(|i| get(i).radius),
         }
     }

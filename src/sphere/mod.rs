@@ -139,7 +139,10 @@ impl<L: Lane> SpherePacket<L> {
                 .unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN))
         };
         SpherePacket {
-            center: V3::from_fn(|i| get(i).center),
+            center: V3::from_fn(
+                #[cfg_attr(target_arch = "x86_64", inline(always))]
+                |i| get(i).center,
+            ),
             radius: L::from_f32_fn(|i| get(i).radius),
         }
     }

@@ -77,14 +77,8 @@ impl<L: Lane> Shear<L> {
         let dz = pick(kz, d);
         // 3. Swap kx and ky when d[kz] < 0, to keep the winding.
         let neg = dz.lt(L::from_f32(0.0));
-        let either = |p: (L::Mask, L::Mask), q: (L::Mask, L::Mask)| {
-            (
-                (neg & p.0) | q.0.and_not(neg),
-                (neg & p.1) | q.1.and_not(neg),
-            )
-        };
-        let kx = either(ky0, kx0);
-        let ky = either(kx0, ky0);
+        let kx = choose::<L>(neg, ky0, kx0);
+        let ky = choose::<L>(neg, kx0, ky0);
         // 4. The shear constants.
         let s = Shear {
             kx,
@@ -110,6 +104,30 @@ impl<L: Lane> Shear<L> {
     fn permute(&self, v: V3<L>) -> V3<L> {
         V3::new(pick(self.kx, v), pick(self.ky, v), pick(self.kz, v))
     }
+}
+
+/// `p` in the lanes of `neg`, `q` in the others, for an axis given as masks (`Shear::new`).
+/// (Functions, not closures, here and in [`signs`]: a closure may be left out of line, and so
+/// run without the target features of a level's copy.)
+#[inline(always)]
+fn choose<L: Lane>(
+    neg: L::Mask,
+    p: (L::Mask, L::Mask),
+    q: (L::Mask, L::Mask),
+) -> (L::Mask, L::Mask) {
+    (
+        (neg & p.0) | q.0.and_not(neg),
+        (neg & p.1) | q.1.and_not(neg),
+    )
+}
+
+/// The edge functions' signs: which are below zero, which above.
+#[inline(always)]
+fn signs<L: Lane>(zero: L, u: L, v: L, w: L) -> ([L::Mask; 3], [L::Mask; 3]) {
+    (
+        [u.lt(zero), v.lt(zero), w.lt(zero)],
+        [u.gt(zero), v.gt(zero), w.gt(zero)],
+    )
 }
 
 /// `v[k]` per lane, for `k` given as masks ("is x", "is y").
@@ -162,22 +180,17 @@ fn sheared<L: Lane>(
     let mut v = ax * cy - ay * cx;
     let mut w = bx * ay - by * ax;
     // 4. An exactly zero edge function may hide the sign: recompute in f64 (exact products).
-    let signs = |u: L, v: L, w: L| {
-        (
-            [u.lt(zero), v.lt(zero), w.lt(zero)],
-            [u.gt(zero), v.gt(zero), w.gt(zero)],
-        )
-    };
-    let (mut lt, mut gt) = signs(u, v, w);
-    let redo = [u, v, w]
-        .iter()
-        .zip(lt.iter().zip(&gt))
-        .fold(Mask::splat(false), |m: L::Mask, (x, (l, g))| {
-            m | x.is_finite().and_not(*l | *g)
-        });
+    let (mut lt, mut gt) = signs(zero, u, v, w);
+    // (A loop, not an iterator chain: its closures may be left out of line, and so run without
+    // the target features of a level's copy.)
+    let mut redo = L::Mask::splat(false);
+    let e = [u, v, w];
+    for k in 0..3 {
+        redo = redo | e[k].is_finite().and_not(lt[k] | gt[k]);
+    }
     if redo.any() {
         (u, v, w) = precise(redo, [ax, ay, bx, by, cx, cy], u, v, w);
-        (lt, gt) = signs(u, v, w);
+        (lt, gt) = signs(zero, u, v, w);
     }
     // 5. Edge tests: all ≥ 0 (front face, det > 0) or, two-sided, all ≤ 0.
     let front = !(lt[0] | lt[1] | lt[2]);
