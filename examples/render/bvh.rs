@@ -156,18 +156,36 @@ pub fn render<L: Lane<Scalar = f32>>(
     threads: usize,
 ) -> Shot {
     let (w, h) = (cam.width, cam.height);
-    // Pass 1: primary rays; per pixel `(t, triangle)`.
-    let (hits, t1) = rows(h, threads, |y| {
-        let mut row = Vec::with_capacity(w as usize);
-        for x in (0..w).step_by(L::LANES) {
-            let p = cam.row_packet::<L>(x, y);
-            let hit = tree.closest(&p);
-            for i in 0..L::LANES.min((w - x) as usize) {
-                row.push(hit.lane(i).map(|r| (p.ray(i), r.t, r.index)));
+    // Pass 1: primary rays in camera tiles of 16 × 4 pixels (blocks of `L`: rays closer
+    // together than a row's, so the packets' frustums are tighter), a band of 4 rows per job;
+    // per pixel `(ray, t, triangle)`.
+    const TW: u32 = 16;
+    const TH: u32 = 4;
+    let (bands, t1) = rows(h.div_ceil(TH), threads, |band| {
+        let y0 = band * TH;
+        let mut rows = vec![Vec::with_capacity(w as usize); TH.min(h - y0) as usize];
+        for x0 in (0..w).step_by(TW as usize) {
+            let hit = tree.closest(&cam.tile::<L, { TW as usize }, { TH as usize }>(x0, y0));
+            for (row, hits) in rows.iter_mut().zip(hit) {
+                for (dx, r) in hits.iter().take((w - x0).min(TW) as usize).enumerate() {
+                    row.push(r.map(|r| (r.t, r.index, x0 + dx as u32)));
+                }
             }
         }
-        row
+        rows
     });
+    let hits: Vec<Vec<Option<(Ray, f32, u32)>>> = bands
+        .into_iter()
+        .flatten()
+        .enumerate()
+        .map(|(y, row)| {
+            row.into_iter()
+                .map(|px| {
+                    px.map(|(t, index, x)| (cam.row_packet::<f32>(x, y as u32).ray(0), t, index))
+                })
+                .collect()
+        })
+        .collect();
     // Pass 2: shadow rays from every hit, `L` at a time; per pixel: lit or not.
     let surface = |ray: &Ray, t: f32, index: u32| {
         let tri = &tris[index as usize];
