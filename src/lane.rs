@@ -26,7 +26,7 @@ mod x86;
 
 pub use portable::X8;
 #[cfg(target_arch = "x86_64")]
-pub(crate) use x86::{Y8, Y16, Z16};
+pub(crate) use x86::{Y8, Y16};
 
 /// The element type of a lane: `f32` or `f64`.
 pub trait Scalar: Copy + Debug + PartialOrd + Default + 'static {

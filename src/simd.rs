@@ -14,8 +14,8 @@
 //! The level is detected once (`cpuid`, and `xgetbv` for the OS's saving of the vector
 //! registers; no `std` needed) and chosen at the query's entry, never per node or kernel.
 //! Below the entry nothing knows about levels: the code is the crate's one generic body, with
-//! a packet's lanes in the level's vectors ([`with_lanes`]: at AVX2 one AVX register for 8
-//! lanes, two for 16; at AVX-512 one register for 16; `wide`'s at the baseline) and a BVH
+//! a packet's lanes in the level's vectors ([`with_lanes`]: at AVX2 and AVX-512 one AVX
+//! register for 8 lanes, two for 16, with the level's instructions; `wide`'s at the baseline) and a BVH
 //! node's 8 children in [`X8`](crate::lane::X8), and every operation a correctly rounded IEEE
 //! operation with no fused multiply-add. **Every level gives the same bits**; only a BVH's box
 //! test, which only prunes, may differ in which boxes it opens (fused where the build itself
@@ -217,10 +217,10 @@ pub trait Packets {
 }
 
 /// Runs `f` compiled for the chosen [`level`], with packets of `lanes` lanes (1, 4, 8 or 16;
-/// any other width runs 16) in that level's vectors: on x86-64 at [`Level::Avx2`] raylane's own
-/// AVX types for 8 and 16 lanes (one and two registers), at [`Level::Avx512`] one AVX-512
-/// register for 16 (and AVX for 8); `wide`'s vectors at the baseline and for 4 lanes; `f32`
-/// for 1. The queries enter here: a packet of `wide::f32x8` is converted in and its records
+/// any other width runs 16) in that level's vectors: on x86-64 at [`Level::Avx2`] and
+/// [`Level::Avx512`] raylane's own AVX types for 8 and 16 lanes (one and two registers,
+/// compiled with the level's instructions: one AVX-512 register for 16 lanes was measured
+/// slower, see docs/design.md); `wide`'s vectors at the baseline and for 4 lanes; `f32` for 1. The queries enter here: a packet of `wide::f32x8` is converted in and its records
 /// out, bit for bit.
 ///
 /// The level's own types exist only on a CPU that has the level: code outside the crate meets
@@ -263,7 +263,7 @@ pub(crate) fn with_lanes_of<L: Lane, F: Packets>(f: F) -> F::Output {
 mod x86 {
     use super::{Level, Packets};
     use crate::lane::Lane;
-    use crate::lane::{Y8, Y16, Z16};
+    use crate::lane::{Y8, Y16};
 
     /// [`super::with_lanes_of`] at `level`. The width is a constant (`if const`): the other
     /// widths' branches are not compiled, so a query has three copies (one per level).
@@ -304,7 +304,7 @@ mod x86 {
                 ),
                 Level::Avx512 => at_v4(
                     #[inline(always)]
-                    || f.run::<Z16>(),
+                    || f.run::<Y16>(),
                 ),
             }
         }

@@ -1,6 +1,7 @@
 //! The lanes of packets at the x86-64 SIMD levels above the baseline ([`crate::simd`]): [`Y8`]
-//! (8 lanes in one AVX register), [`Y16`] (16 in two) and [`Z16`] (16 in one AVX-512
-//! register, masks in a mask register, [`K16`]).
+//! (8 lanes in one AVX register) and [`Y16`] (16 in two), at the AVX2 and the AVX-512 level
+//! alike (a type of 16 lanes in one AVX-512 register, its masks in a mask register, was
+//! measured and removed: see docs/design.md).
 //!
 //! **Only where the CPU has them.** Their operations are the level's instructions, so a value
 //! of these types may exist only in a program whose CPU has that level: the types are private
@@ -28,14 +29,6 @@ pub struct Y8(__m256);
 /// Sixteen `f32` lanes in two AVX registers (the AVX2 level's packets of 16).
 #[derive(Clone, Copy)]
 pub struct Y16([__m256; 2]);
-
-/// Sixteen `f32` lanes in one AVX-512 register (the AVX-512 level's packets of 16).
-#[derive(Clone, Copy)]
-pub struct Z16(__m512);
-
-/// The lanes of a [`Z16`] comparison: one bit per lane (an AVX-512 mask register).
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct K16(u16);
 
 // SAFETY (every `unsafe` block below): the AVX, AVX2 and AVX-512 instructions these use exist
 // on the CPU, because a value of these types exists only there (see the module docs); loads
@@ -70,19 +63,6 @@ impl Y16 {
     }
 }
 
-impl Z16 {
-    #[inline(always)]
-    fn array(self) -> [f32; 16] {
-        // SAFETY: `__m512` and `[f32; 16]` are 64 bytes of plain data.
-        unsafe { core::mem::transmute::<__m512, [f32; 16]>(self.0) }
-    }
-    #[inline(always)]
-    fn from_array(a: [f32; 16]) -> Self {
-        // SAFETY: as above.
-        Z16(unsafe { core::mem::transmute::<[f32; 16], __m512>(a) })
-    }
-}
-
 macro_rules! debug {
     ($t:ty) => {
         impl fmt::Debug for $t {
@@ -94,36 +74,32 @@ macro_rules! debug {
 }
 debug!(Y8);
 debug!(Y16);
-debug!(Z16);
 
 /// The arithmetic operators of a type from one intrinsic per register.
 macro_rules! binary {
-    ($t:ident, $tr:ident, $f:ident, $y:ident, $z:ident) => {
+    ($t:ident, $tr:ident, $f:ident, $y:ident) => {
         impl $tr for $t {
             type Output = Self;
             #[inline(always)]
             fn $f(self, o: Self) -> Self {
-                binary!(@ $t, self, o, $y, $z)
+                binary!(@ $t, self, o, $y)
             }
         }
     };
-    (@ Y8, $a:ident, $b:ident, $y:ident, $z:ident) => {
+    (@ Y8, $a:ident, $b:ident, $y:ident) => {
         Y8(unsafe { $y($a.0, $b.0) })
     };
-    (@ Y16, $a:ident, $b:ident, $y:ident, $z:ident) => {
+    (@ Y16, $a:ident, $b:ident, $y:ident) => {
         Y16(unsafe { [$y($a.0[0], $b.0[0]), $y($a.0[1], $b.0[1])] })
-    };
-    (@ Z16, $a:ident, $b:ident, $y:ident, $z:ident) => {
-        Z16(unsafe { $z($a.0, $b.0) })
     };
 }
 
 macro_rules! arithmetic {
     ($t:ident) => {
-        binary!($t, Add, add, _mm256_add_ps, _mm512_add_ps);
-        binary!($t, Sub, sub, _mm256_sub_ps, _mm512_sub_ps);
-        binary!($t, Mul, mul, _mm256_mul_ps, _mm512_mul_ps);
-        binary!($t, Div, div, _mm256_div_ps, _mm512_div_ps);
+        binary!($t, Add, add, _mm256_add_ps);
+        binary!($t, Sub, sub, _mm256_sub_ps);
+        binary!($t, Mul, mul, _mm256_mul_ps);
+        binary!($t, Div, div, _mm256_div_ps);
         impl Neg for $t {
             type Output = Self;
             #[inline(always)]
@@ -135,13 +111,12 @@ macro_rules! arithmetic {
 }
 arithmetic!(Y8);
 arithmetic!(Y16);
-arithmetic!(Z16);
 
 /// Bitwise operations of the vector masks (Y8, Y16: all-ones lanes).
 macro_rules! vector_mask {
     ($t:ident) => {
-        binary!($t, BitAnd, bitand, _mm256_and_ps, _mm512_and_ps);
-        binary!($t, BitOr, bitor, _mm256_or_ps, _mm512_or_ps);
+        binary!($t, BitAnd, bitand, _mm256_and_ps);
+        binary!($t, BitOr, bitor, _mm256_or_ps);
         impl Not for $t {
             type Output = Self;
             #[inline(always)]
@@ -168,66 +143,6 @@ impl core::ops::BitXor<f32> for Y16 {
     fn bitxor(self, o: f32) -> Self {
         let k = unsafe { _mm256_set1_ps(o) };
         Y16(unsafe { [_mm256_xor_ps(self.0[0], k), _mm256_xor_ps(self.0[1], k)] })
-    }
-}
-
-impl core::ops::BitXor<f32> for Z16 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitxor(self, o: f32) -> Self {
-        Z16(unsafe { _mm512_xor_ps(self.0, _mm512_set1_ps(o)) })
-    }
-}
-
-impl BitAnd for K16 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitand(self, o: Self) -> Self {
-        K16(self.0 & o.0)
-    }
-}
-
-impl BitOr for K16 {
-    type Output = Self;
-    #[inline(always)]
-    fn bitor(self, o: Self) -> Self {
-        K16(self.0 | o.0)
-    }
-}
-
-impl Not for K16 {
-    type Output = Self;
-    #[inline(always)]
-    fn not(self) -> Self {
-        K16(!self.0)
-    }
-}
-
-impl Mask for K16 {
-    #[inline(always)]
-    fn splat(b: bool) -> Self {
-        K16(if b { u16::MAX } else { 0 })
-    }
-    #[inline(always)]
-    fn any(self) -> bool {
-        self.0 != 0
-    }
-    #[inline(always)]
-    fn all(self) -> bool {
-        self.0 == u16::MAX
-    }
-    #[inline(always)]
-    fn bits(self) -> u32 {
-        u32::from(self.0)
-    }
-    #[inline(always)]
-    fn with_lane(self, i: usize, b: bool) -> Self {
-        let bit = 1u16.checked_shl(i as u32).unwrap_or(0);
-        K16(if b { self.0 | bit } else { self.0 & !bit })
-    }
-    #[inline(always)]
-    fn from_bits(bits: u32) -> Self {
-        K16(bits as u16)
     }
 }
 
@@ -410,17 +325,14 @@ macro_rules! lane {
     };
     (@sqrt Y8, $a:ident) => { Y8(unsafe { _mm256_sqrt_ps($a.0) }) };
     (@sqrt Y16, $a:ident) => { Y16(unsafe { [_mm256_sqrt_ps($a.0[0]), _mm256_sqrt_ps($a.0[1])] }) };
-    (@sqrt Z16, $a:ident) => { Z16(unsafe { _mm512_sqrt_ps($a.0) }) };
     (@cmp Y8, $a:ident, $b:ident, $p:ident) => { Y8(unsafe { _mm256_cmp_ps::<$p>($a.0, $b.0) }) };
     (@cmp Y16, $a:ident, $b:ident, $p:ident) => {
         Y16(unsafe { [_mm256_cmp_ps::<$p>($a.0[0], $b.0[0]), _mm256_cmp_ps::<$p>($a.0[1], $b.0[1])] })
     };
-    (@cmp Z16, $a:ident, $b:ident, $p:ident) => { K16(unsafe { _mm512_cmp_ps_mask::<$p>($a.0, $b.0) }) };
     (@select Y8, $m:ident, $a:ident, $b:ident) => { Y8(unsafe { _mm256_blendv_ps($b.0, $a.0, $m.0) }) };
     (@select Y16, $m:ident, $a:ident, $b:ident) => {
         Y16(unsafe { [_mm256_blendv_ps($b.0[0], $a.0[0], $m.0[0]), _mm256_blendv_ps($b.0[1], $a.0[1], $m.0[1])] })
     };
-    (@select Z16, $m:ident, $a:ident, $b:ident) => { Z16(unsafe { _mm512_mask_blend_ps($m.0, $b.0, $a.0) }) };
     (@abs Y8, $a:ident) => { Y8(unsafe { _mm256_andnot_ps(_mm256_set1_ps(-0.0), $a.0) }) };
     (@abs Y16, $a:ident) => {
         Y16(unsafe {
@@ -428,8 +340,6 @@ macro_rules! lane {
             [_mm256_andnot_ps(s, $a.0[0]), _mm256_andnot_ps(s, $a.0[1])]
         })
     };
-    (@abs Z16, $a:ident) => { Z16(unsafe { _mm512_abs_ps($a.0) }) };
 }
 lane!(Y8, 8, Y8);
 lane!(Y16, 16, Y16);
-lane!(Z16, 16, K16);
