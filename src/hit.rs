@@ -945,13 +945,13 @@ impl Record for Sphere {
         if w.mask.none() {
             return Hits::miss();
         }
-        let get = |i: usize| {
-            (if w.mask.test(i) { sphere(i) } else { None })
-                .unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN))
-        };
         let c = V3::<L>::from_fn(
             #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |i| get(i).center(),
+            |i| {
+                (if w.mask.test(i) { sphere(i) } else { None })
+                    .unwrap_or(Sphere::new(Vec3::ZERO, f32::NAN))
+                    .center()
+            },
         );
         let point = rays.origin.along(rays.dir, w.t);
         let n = unit(point - c, w.mask, |i| {
