@@ -249,8 +249,8 @@ fn hits_out<L: Lane, M: Lane<Scalar = f32>>(h: &Hits<M>) -> Hits<L> {
 
 /// Packets of plain `f32` lanes run at the [level](crate::simd) chosen when the program runs,
 /// in its vectors ([`simd::with_lanes`]: raylane's own AVX and AVX-512 types for 8 and 16
-/// lanes on x86-64), converted in and out bit for bit; other lane types (counting, `f64`) run
-/// as they are.
+/// lanes on x86-64), converted in and out bit for bit; other lane types (counting, `f64`), and
+/// scenes ([`Trace::LEVEL_LANES`]), run as they are.
 impl<L: Lane> Rays for RayPacket<L> {
     type Closest = Hits<L>;
     type Any = L::Mask;
@@ -266,7 +266,7 @@ impl<L: Lane> Rays for RayPacket<L> {
                 hits_out(&closest_packet(self.0, &packet_in::<L, M>(self.1)))
             }
         }
-        if const { L::PLAIN_F32 } {
+        if const { L::PLAIN_F32 && T::LEVEL_LANES } {
             simd::with_lanes_of::<L, _>(Q(t, rays))
         } else {
             closest_packet(t, rays)
@@ -283,7 +283,7 @@ impl<L: Lane> Rays for RayPacket<L> {
                 L::Mask::from_bits(any_packet(self.0, &packet_in::<L, M>(self.1)).bits())
             }
         }
-        if const { L::PLAIN_F32 } {
+        if const { L::PLAIN_F32 && T::LEVEL_LANES } {
             simd::with_lanes_of::<L, _>(Q(t, rays))
         } else {
             any_packet(t, rays)
@@ -308,7 +308,7 @@ impl<L: Lane> Rays for RayPacket<L> {
                 self.0.trace(&r, 0, &mut c);
             }
         }
-        if const { L::PLAIN_F32 } {
+        if const { L::PLAIN_F32 && T::LEVEL_LANES } {
             simd::with_lanes_of::<L, _>(Q(t, rays, f, core::marker::PhantomData))
         } else {
             let mut c = All::new(rays, |h: &Hits<L>| f(*h));
@@ -347,7 +347,11 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
                 out
             }
         }
-        simd::with_lanes_of::<L, _>(Q(t, tile))
+        if const { T::LEVEL_LANES } {
+            simd::with_lanes_of::<L, _>(Q(t, tile))
+        } else {
+            simd::Packets::run::<L>(Q(t, tile))
+        }
     }
 
     #[inline]
@@ -373,7 +377,11 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
                 out
             }
         }
-        simd::with_lanes_of::<L, _>(Q(t, tile))
+        if const { T::LEVEL_LANES } {
+            simd::with_lanes_of::<L, _>(Q(t, tile))
+        } else {
+            simd::Packets::run::<L>(Q(t, tile))
+        }
     }
 
     #[inline]
@@ -405,6 +413,10 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
                 }
             }
         }
-        simd::with_lanes_of::<L, _>(Q(t, tile, f))
+        if const { T::LEVEL_LANES } {
+            simd::with_lanes_of::<L, _>(Q(t, tile, f))
+        } else {
+            simd::Packets::run::<L>(Q(t, tile, f))
+        }
     }
 }

@@ -29,6 +29,14 @@ use crate::triangle::{Triangle, Watertight};
 
 /// Anything a query runs, its kernel chosen (see the [module docs](self)).
 pub trait Trace {
+    /// Whether a packet query on it runs in the [SIMD level](crate::simd)'s own lane types:
+    /// true where its traversal is inlined whole into the level's copy of the query. A
+    /// scene's is not (its nested traversals inlined whole made the compile time explode, see
+    /// docs/design.md): its packets run in the caller's lanes, at the build's own level,
+    /// rather than in the level's types outside the level's copy (every vector operation
+    /// then a call).
+    const LEVEL_LANES: bool = true;
+
     /// How many values of [`Hit::set`](crate::Hit::set) it uses from its `set` on: 1 for a set,
     /// the instances of a [`Scene`](crate::bvh::Scene), the sum for a tuple.
     #[cfg_attr(target_arch = "x86_64", inline(always))]
@@ -60,6 +68,9 @@ pub trait Set {
     type Prim: Record;
     /// The kernel of a plain query.
     type Kernel: Kernel<Self::Prim>;
+
+    /// As [`Trace::LEVEL_LANES`].
+    const LEVEL_LANES: bool = true;
 
     /// As [`Trace::sets`].
     #[cfg_attr(target_arch = "x86_64", inline(always))]
@@ -146,6 +157,7 @@ impl<'a, S: ?Sized, K> Using<'a, S, K> {
 }
 
 impl<S: Set + ?Sized> Trace for S {
+    const LEVEL_LANES: bool = S::LEVEL_LANES;
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
@@ -169,6 +181,7 @@ impl<S: Set + ?Sized> Trace for S {
 }
 
 impl<S: Set + ?Sized, K: Kernel<S::Prim>> Trace for Using<'_, S, K> {
+    const LEVEL_LANES: bool = S::LEVEL_LANES;
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
@@ -194,6 +207,7 @@ impl<S: Set + ?Sized, K: Kernel<S::Prim>> Trace for Using<'_, S, K> {
 impl<S: Set + ?Sized> Set for &S {
     type Prim = S::Prim;
     type Kernel = S::Kernel;
+    const LEVEL_LANES: bool = S::LEVEL_LANES;
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
@@ -346,6 +360,7 @@ impl<'a, T: ?Sized, F> Filtered<'a, T, F> {
 }
 
 impl<T: Trace + ?Sized, F: Filter> Trace for Filtered<'_, T, F> {
+    const LEVEL_LANES: bool = T::LEVEL_LANES;
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn sets(&self) -> u32 {
@@ -687,6 +702,7 @@ pub(crate) fn select_hits<L: Lane>(m: L::Mask, a: &Hits<L>, b: &Hits<L>) -> Hits
 macro_rules! tuple {
     ($($q:ident $i:tt),+) => {
         impl<$($q: Trace),+> Trace for ($($q,)+) {
+            const LEVEL_LANES: bool = true $(&& $q::LEVEL_LANES)+;
             #[cfg_attr(target_arch = "x86_64", inline(always))]
             #[cfg_attr(not(target_arch = "x86_64"), inline)]
             fn sets(&self) -> u32 {

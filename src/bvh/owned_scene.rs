@@ -750,6 +750,7 @@ fn empty_top() -> OwnedBvh<Inst4> {
 /// the one traversal, and a packet's lanes that do not see an instance (its mask, an ignored
 /// instance) trace past it with an empty interval.
 impl Trace for OwnedScene {
+    const LEVEL_LANES: bool = false;
     #[inline]
     fn sets(&self) -> u32 {
         self.placed.len() as u32
@@ -798,6 +799,7 @@ impl<T, S> WithKernels<'_, T, S> {
 }
 
 impl<T: Kernel<Triangle>, S: Kernel<Sphere>> Trace for WithKernels<'_, T, S> {
+    const LEVEL_LANES: bool = false;
     #[inline]
     fn sets(&self) -> u32 {
         Trace::sets(self.scene)

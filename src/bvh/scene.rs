@@ -335,6 +335,7 @@ impl<'s, P: Leaf, N: Layout> Scene<'s, P, N> {
 impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
     type Prim = P::Prim;
     type Kernel = P::Kernel;
+    const LEVEL_LANES: bool = false;
 
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     #[cfg_attr(not(target_arch = "x86_64"), inline)]
