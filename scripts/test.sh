@@ -140,12 +140,13 @@ printf '%-20s' "recommended"
 step "every SIMD level's copy inlined: no intrinsic called out of line on a hot path"
 # A function the compiler leaves out of line inside a level's copy runs without its level's
 # instructions (scripts/inline-check.sh): checked on the render, on the scenes benchmark
-# (every set, kernel and query kind it times) and on the game (an owned scene's queries,
-# packets and filters), as users build them.
-cargo build --quiet --release -p raylane-bench --features peers --example scenes
+# (every set, kernel and query kind it times), on the per-test counts (every kernel on its
+# library path at every width) and on the game (an owned scene's queries, packets and
+# filters), as users build them.
+cargo build --quiet --release -p raylane-bench --features peers --example scenes --example count
 cargo build --quiet --release --example game
 ./scripts/inline-check.sh target/release/examples/render target/release/examples/scenes \
-  target/release/examples/game || fail "a hot path runs without its SIMD level's instructions"
+  target/release/examples/count target/release/examples/game || fail "a hot path runs without its SIMD level's instructions"
 
 mkdir -p target/digests
 # Run times of the digest runs: "NAME SECONDS" lines.

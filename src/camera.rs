@@ -94,6 +94,8 @@ impl Pinhole {
     /// y)`'s ray is the same, bit for bit, in a row, a block or a [`Tile`]; outside the image
     /// as [`row_packet`](Self::row_packet).
     #[must_use]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     pub fn block_packet<L: Lane>(&self, x: u32, y: u32) -> RayPacket<L> {
         self.packet(x, y, block::<L>().0)
     }
@@ -115,6 +117,8 @@ impl Pinhole {
     }
 
     /// Pixels `(x + i mod w, y + i div w)` in lane `i` (see [`row_packet`](Self::row_packet)).
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn packet<L: Lane>(&self, x: u32, y: u32, w: usize) -> RayPacket<L> {
         // Column and row of lane i, in u64 so that they cannot wrap (x, y ≤ u32::MAX, i < 2^32).
         let col = |i: usize| u64::from(x) + offset(i, w).0 as u64;
@@ -177,23 +181,36 @@ impl<L: Lane, const W: usize, const H: usize> Tile<'_, L, W, H> {
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     #[cfg_attr(not(target_arch = "x86_64"), inline)]
     pub fn packets(&self) -> impl Iterator<Item = (usize, usize, RayPacket<L>)> + '_ {
-        let (bw, bh) = const {
-            let (bw, bh) = block::<L>();
-            assert!(
-                W.is_multiple_of(bw) && H.is_multiple_of(bh),
-                "a tile is whole blocks of its lane type"
-            );
-            (bw, bh)
-        };
-        (0..H / bh).flat_map(move |j| {
-            (0..W / bw).map(move |i| {
-                let (dx, dy) = (i * bw, j * bh);
-                let (x, y) = (self.x as u64 + dx as u64, self.y as u64 + dy as u64);
-                // Blocks past u32::MAX are outside the image: its last column or row.
-                let clamp = |v: u64| u32::try_from(v).unwrap_or(u32::MAX);
-                (dx, dy, self.camera.block_packet::<L>(clamp(x), clamp(y)))
-            })
-        })
+        (0..Self::BLOCKS).map(|k| self.block_in::<L>(k))
+    }
+
+    /// How many blocks of `L` it holds.
+    pub(crate) const BLOCKS: usize = {
+        let (bw, bh) = block::<L>();
+        assert!(
+            W.is_multiple_of(bw) && H.is_multiple_of(bh),
+            "a tile is whole blocks of its lane type"
+        );
+        (W / bw) * (H / bh)
+    };
+
+    /// Block `k` of [`packets`](Self::packets) (row by row) in lanes `M` of `L`'s width (the
+    /// same rays, bit for bit): a query made in the [SIMD level](crate::simd)'s own lanes
+    /// makes its rays there too. (`M` of another width is not refused, as the level's
+    /// branches for other widths are instantiated though never run; its packets would be the
+    /// wrong shape.)
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    pub(crate) fn block_in<M: Lane>(&self, k: usize) -> (usize, usize, RayPacket<M>) {
+        let (bw, bh) = block::<L>();
+        let (dx, dy) = ((k % (W / bw)) * bw, (k / (W / bw)) * bh);
+        let (x, y) = (self.x as u64 + dx as u64, self.y as u64 + dy as u64);
+        // Blocks past u32::MAX are outside the image: its last column or row.
+        let (x, y) = (
+            u32::try_from(x).unwrap_or(u32::MAX),
+            u32::try_from(y).unwrap_or(u32::MAX),
+        );
+        (dx, dy, self.camera.block_packet::<M>(x, y))
     }
 
     /// The tile's corner pixel.

@@ -171,7 +171,8 @@ impl<'c> FocalMesh<'c> {
     /// directions, `v² > k_lo` with `v = T·U` (4 mul, 2 add, 1 cmp). Over the whole line, the
     /// cached `k_lo` (`c² − r²` lowered by its rounding bound) makes a rejected lane a certain
     /// miss, and an eye inside the sphere (`k_lo < 0`) rejects none.
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     #[must_use]
     pub fn may_hit<L: Lane>(&self, rays: &FocalRays<L>) -> L::Mask {
         match &self.bound {
@@ -227,7 +228,9 @@ impl<'c> FocalMesh<'c> {
             keep,
             self.cache,
             &mut inner,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
             |r, e| tf::candidate(r, &tf::Splat(e), cull),
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
             |r, i, e, inner| {
                 let h = tf::maybe_hit(r, &tf::Splat(e), cull)?;
                 let at = At {
@@ -342,22 +345,61 @@ impl Trace for FocalSpheres<'_> {
                 at,
                 self.cache,
                 c,
+                #[cfg_attr(target_arch = "x86_64", inline(always))]
                 |r, e| Focal::candidate(r, &Splat(e)),
+                #[cfg_attr(target_arch = "x86_64", inline(always))]
                 |r, i, e, c| {
                     let at = At {
                         set,
                         index: i as u32,
                         loc: i as u32,
                     };
-                    let record = |w: &Winners<L>| {
-                        Sphere::records(rays, w, cull, |_| self.spheres.get(i).copied())
-                    };
                     let roots = Focal::maybe_roots(r, &Splat(e))?;
+                    // The record as a function, not a let-bound closure, which may be left
+                    // out of line (crate::simd).
+                    #[inline(always)]
+                    fn record<L: Lane>(
+                        rays: &RayPacket<L>,
+                        w: &Winners<L>,
+                        cull: Cull,
+                        sphere: Option<Sphere>,
+                    ) -> Hits<L> {
+                        Sphere::records(
+                            rays,
+                            w,
+                            cull,
+                            #[cfg_attr(target_arch = "x86_64", inline(always))]
+                            |_| sphere,
+                        )
+                    }
+                    let sphere = self.spheres.get(i).copied();
                     if C::EACH {
-                        Some(each_root(&roots, cull, |h| c.offer(h, at, record)))
+                        Some(each_root(
+                            &roots,
+                            cull,
+                            #[cfg_attr(target_arch = "x86_64", inline(always))]
+                            |h| {
+                                c.offer(
+                                    h,
+                                    at,
+                                    #[cfg_attr(target_arch = "x86_64", inline(always))]
+                                    |w: &Winners<L>| record(rays, w, cull, sphere),
+                                )
+                            },
+                        ))
                     } else {
                         let h = first_root(&roots, cull);
-                        h.mask.any().then(|| c.offer(&h, at, record))
+                        h.mask.any().then(
+                            #[cfg_attr(target_arch = "x86_64", inline(always))]
+                            || {
+                                c.offer(
+                                    &h,
+                                    at,
+                                    #[cfg_attr(target_arch = "x86_64", inline(always))]
+                                    |w: &Winners<L>| record(rays, w, cull, sphere),
+                                )
+                            },
+                        )
                     }
                 },
             );

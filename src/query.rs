@@ -337,8 +337,9 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
             #[inline(always)]
             fn run<M: Lane<Scalar = f32>>(self) -> Self::Output {
                 let mut out = [[None; W]; H];
-                for (dx, dy, rays) in self.1.packets() {
-                    let hits = closest_packet(self.0, &packet_in::<L, M>(&rays));
+                for k in 0..Tile::<L, W, H>::BLOCKS {
+                    let (dx, dy, rays) = self.1.block_in::<M>(k);
+                    let hits = closest_packet(self.0, &rays);
                     for i in 0..L::LANES {
                         let (px, py) = block_lane::<L>(i);
                         out[dy + py][dx + px] = hits.lane(i);
@@ -367,8 +368,9 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
             #[inline(always)]
             fn run<M: Lane<Scalar = f32>>(self) -> Self::Output {
                 let mut out = [[false; W]; H];
-                for (dx, dy, rays) in self.1.packets() {
-                    let hit = any_packet(self.0, &packet_in::<L, M>(&rays));
+                for k in 0..Tile::<L, W, H>::BLOCKS {
+                    let (dx, dy, rays) = self.1.block_in::<M>(k);
+                    let hit = any_packet(self.0, &rays);
                     for i in 0..L::LANES {
                         let (px, py) = block_lane::<L>(i);
                         out[dy + py][dx + px] = hit.test(i);
@@ -399,8 +401,8 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
             fn run<M: Lane<Scalar = f32>>(self) {
                 let (x, y) = self.1.origin();
                 let f = self.2;
-                for (dx, dy, rays) in self.1.packets() {
-                    let r = packet_in::<L, M>(&rays);
+                for k in 0..Tile::<L, W, H>::BLOCKS {
+                    let (dx, dy, r) = self.1.block_in::<M>(k);
                     let mut c = All::new(&r, |h: &Hits<M>| {
                         for i in 0..L::LANES {
                             if let Some(hit) = h.lane(i) {

@@ -184,7 +184,8 @@ pub type Ray16 = RayPacket<wide::f32x16>;
 
 impl<L: Lane> RayPacket<L> {
     /// Rays from lane values; lanes with bad input get the empty interval (never hit).
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     #[must_use]
     pub fn new(origin: V3<L>, dir: V3<L>, t_min: L, t_max: L) -> Self {
         let zero = L::from_f32(0.0);

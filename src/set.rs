@@ -514,16 +514,27 @@ pub(crate) fn filtered<L: Lane, E, C: Collector<L>>(
     let mut r = only(rays, keep);
     let neg = L::from_f32(f32::NEG_INFINITY);
     r.t_max = L::select(keep, c.t_max(), neg);
-    let mut one = |r: &mut RayPacket<L>, i: usize, e: &E, c: &mut C| match test(r, i, e, c) {
-        None => false,
-        Some(stop) => {
-            r.t_max = L::select(keep, c.t_max(), neg);
-            stop
+    // A function, not a let-bound closure, which may be left out of line (crate::simd).
+    #[inline(always)]
+    fn one<L: Lane, E, C: Collector<L>>(
+        test: &mut impl FnMut(&RayPacket<L>, usize, &E, &mut C) -> Option<bool>,
+        (keep, neg): (L::Mask, L),
+        r: &mut RayPacket<L>,
+        i: usize,
+        e: &E,
+        c: &mut C,
+    ) -> bool {
+        match test(r, i, e, c) {
+            None => false,
+            Some(stop) => {
+                r.t_max = L::select(keep, c.t_max(), neg);
+                stop
+            }
         }
-    };
+    }
     if L::LANES == 1 {
         for (i, e) in entries.iter().enumerate() {
-            if one(&mut r, i, e, c) {
+            if one(&mut test, (keep, neg), &mut r, i, e, c) {
                 return true;
             }
         }
@@ -535,7 +546,7 @@ pub(crate) fn filtered<L: Lane, E, C: Collector<L>>(
             let j = bits.trailing_zeros() as usize;
             bits &= bits - 1;
             if let Some(e) = block.get(j)
-                && one(&mut r, b * 64 + j, e, c)
+                && one(&mut test, (keep, neg), &mut r, b * 64 + j, e, c)
             {
                 return true;
             }

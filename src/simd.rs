@@ -21,6 +21,10 @@
 //! test, which only prunes, may differ in which boxes it opens (fused where the build itself
 //! targets FMA, see [`bvh`](crate::bvh)).
 //!
+//! Packets asked of an instanced scene ([`Scene`](crate::bvh::Scene),
+//! `OwnedScene`) run in the caller's lanes at the build's own level
+//! ([`Trace::LEVEL_LANES`](crate::set::Trace::LEVEL_LANES)); their single rays enter the level.
+//!
 //! The BVH build and the baker are not dispatched: they run at the build's own level, and a
 //! default build builds as fast as a build for the CPU (scenes benchmark, this AMD EPYC, one
 //! run each: 0.9 / 0.8 ms for the vendored bunny, 320.8 / 330.3 ms for Loop×4, 33.4 / 30.7 ms

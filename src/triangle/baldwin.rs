@@ -79,15 +79,19 @@ impl PrecomputedKernel for BaldwinWeber {
         let zero = L::from_f32(0.0);
         let inv = L::from_f32(1.0) / n.x;
         let abs = inv.abs();
+        // Indexed, not `array::map`, which may be left out of line (crate::simd).
         let rows = [
-            V3::new(zero, e2.z * inv, -(e2.y * inv)),
-            V3::new(zero, -(e1.z * inv), e1.y * inv),
-            V3::new(n.x * abs, n.y * abs, n.z * abs),
-        ]
-        .map(|r| uncyclic(k, r));
+            uncyclic(k, V3::new(zero, e2.z * inv, -(e2.y * inv))),
+            uncyclic(k, V3::new(zero, -(e1.z * inv), e1.y * inv)),
+            uncyclic(k, V3::new(n.x * abs, n.y * abs, n.z * abs)),
+        ];
         AffineRecord {
             rows,
-            w: rows.map(|r| -r.dot(tri.a)),
+            w: [
+                -rows[0].dot(tri.a),
+                -rows[1].dot(tri.a),
+                -rows[2].dot(tri.a),
+            ],
         }
     }
 

@@ -524,7 +524,8 @@ impl<L: Lane> FocalRays<L> {
     /// Prepares `rays` (which must start at the eye of the caches they are tested against):
     /// 3 mul and 2 cmp for the scaling, 6 mul, 2 add, 1 div, 1 sqrt for the unit direction;
     /// the power of two and the scaled interval are found per lane in `f64` (not counted).
-    #[inline]
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     #[must_use]
     pub fn new(rays: &RayPacket<L>) -> Self {
         let d = rays.dir;

@@ -96,11 +96,13 @@ impl TriangleKernel for Plucker {
         let tn = v0.dot(n);
         let neg = sum.lt(zero);
         let dneg = den.lt(zero);
-        let fold = |x: L| {
+        // A function, not a let-bound closure, which may be left out of line (crate::simd).
+        #[inline(always)]
+        fn fold<L: Lane>(x: L, neg: L::Mask, zero: L) -> L {
             let x = L::select(neg, -x, x);
             L::select(x.lt(zero), zero, x)
-        };
-        let (us, vs, ws) = (fold(u), fold(v), fold(w));
+        }
+        let (us, vs, ws) = (fold(u, neg, zero), fold(v, neg, zero), fold(w, neg, zero));
         let asum = us + vs + ws;
         let ad = L::select(dneg, -den, den);
         mask = mask & ad.gt(zero) & asum.gt(zero);
