@@ -345,7 +345,6 @@ impl Trace for FocalSpheres<'_> {
                 at,
                 self.cache,
                 c,
-                #[cfg_attr(target_arch = "x86_64", inline(always))]
                 |r, e| Focal::candidate(r, &Splat(e)),
                 #[cfg_attr(target_arch = "x86_64", inline(always))]
                 |r, i, e, c| {
@@ -362,17 +361,17 @@ impl Trace for FocalSpheres<'_> {
                         rays: &RayPacket<L>,
                         w: &Winners<L>,
                         cull: Cull,
-                        sphere: Option<Sphere>,
+                        sphere: Option<&Sphere>,
                     ) -> Hits<L> {
                         Sphere::records(
                             rays,
                             w,
                             cull,
                             #[cfg_attr(target_arch = "x86_64", inline(always))]
-                            |_| sphere,
+                            |_| sphere.copied(),
                         )
                     }
-                    let sphere = self.spheres.get(i).copied();
+                    let sphere = self.spheres.get(i);
                     if C::EACH {
                         Some(each_root(
                             &roots,
