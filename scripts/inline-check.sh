@@ -2,9 +2,9 @@
 # Checks that the per-level copies of raylane's queries (raylane::simd) run their hot paths
 # with their level's features: in each x86-64 binary given, no function may call a
 # `core::arch` intrinsic out of line except the cold paths listed below (f64 fallbacks, exact
-# edge signs, tie breaks; each `#[inline(never)]`). A function the compiler leaves out of line inside a copy
-# (a closure, an iterator adapter, `array::map`) is compiled for the baseline, so every
-# intrinsic in it becomes a call: the same answers, several times slower.
+# edge signs, tie breaks; each `#[inline(never)]`). A function the compiler leaves out of line
+# inside a copy (a closure, an iterator adapter, `array::map`) is compiled for the baseline, so
+# every intrinsic in it becomes a call: the same answers, several times slower.
 #
 #   ./scripts/inline-check.sh target/release/examples/render target/release/examples/game
 set -euo pipefail

@@ -146,7 +146,8 @@ step "every SIMD level's copy inlined: no intrinsic called out of line on a hot 
 cargo build --quiet --release -p raylane-bench --features peers --example scenes --example count
 cargo build --quiet --release --example game
 ./scripts/inline-check.sh target/release/examples/render target/release/examples/scenes \
-  target/release/examples/count target/release/examples/game || fail "a hot path runs without its SIMD level's instructions"
+  target/release/examples/count target/release/examples/game \
+  || fail "a hot path runs without its SIMD level's instructions"
 
 mkdir -p target/digests
 # Run times of the digest runs: "NAME SECONDS" lines.

@@ -317,6 +317,17 @@ impl<L: Lane> Rays for RayPacket<L> {
     }
 }
 
+/// A tile's query: in the [level](crate::simd)'s lanes, entered once for the whole tile, or
+/// (scenes, [`Trace::LEVEL_LANES`]) in the tile's own.
+#[inline(always)]
+fn tile_entry<T: Trace + ?Sized, L: Lane<Scalar = f32>, F: simd::Packets>(f: F) -> F::Output {
+    if const { T::LEVEL_LANES } {
+        simd::with_lanes_of::<L, F>(f)
+    } else {
+        f.run::<L>()
+    }
+}
+
 /// A tile enters the [level](crate::simd) once, its packets in the level's vectors.
 impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L, W, H> {
     type Closest = [[Option<Hit>; W]; H];
@@ -348,11 +359,7 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
                 out
             }
         }
-        if const { T::LEVEL_LANES } {
-            simd::with_lanes_of::<L, _>(Q(t, tile))
-        } else {
-            simd::Packets::run::<L>(Q(t, tile))
-        }
+        tile_entry::<T, L, _>(Q(t, tile))
     }
 
     #[inline]
@@ -379,11 +386,7 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
                 out
             }
         }
-        if const { T::LEVEL_LANES } {
-            simd::with_lanes_of::<L, _>(Q(t, tile))
-        } else {
-            simd::Packets::run::<L>(Q(t, tile))
-        }
+        tile_entry::<T, L, _>(Q(t, tile))
     }
 
     #[inline]
@@ -415,10 +418,6 @@ impl<L: Lane<Scalar = f32>, const W: usize, const H: usize> Rays for Tile<'_, L,
                 }
             }
         }
-        if const { T::LEVEL_LANES } {
-            simd::with_lanes_of::<L, _>(Q(t, tile, f))
-        } else {
-            simd::Packets::run::<L>(Q(t, tile, f))
-        }
+        tile_entry::<T, L, _>(Q(t, tile, f))
     }
 }
