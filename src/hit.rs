@@ -66,8 +66,8 @@ pub struct Hit {
     pub front: bool,
     /// Index of the primitive in its set.
     pub index: u32,
-    /// Which set of a scene: the position in a tuple of sets, the instance of a
-    /// [`Scene`](crate::bvh::Scene); 0 for a plain set.
+    /// Which set of a scene: the position in a tuple of sets or in [`Sets`](crate::set::Sets),
+    /// the instance of a [`Scene`](crate::bvh::Scene); 0 for a plain set.
     pub set: u32,
     /// Barycentric weight of vertex B for triangles; 0 otherwise.
     pub u: f32,

@@ -10,8 +10,9 @@
 //!
 //! It is implemented by every set ([`Trace`]): `[Sphere]`, `[Triangle]`, `[Plane]`,
 //! [`Mesh`](crate::mesh::Mesh), [`Bvh`](crate::bvh::Bvh), [`Scene`](crate::bvh::Scene), the
-//! focal caches ([`crate::focal`]) and tuples of up to four of them (a scene whose hits carry
-//! the member's position in [`Hit::set`]). A set of primitives uses its default kernel
+//! focal caches ([`crate::focal`]), tuples of up to four of them and
+//! [`Sets`](crate::set::Sets), a slice of them (a scene whose hits carry the member's position
+//! in [`Hit::set`]). A set of primitives uses its default kernel
 //! ([`Robust`](crate::sphere::Robust) for spheres, [`Watertight`](crate::triangle::Watertight)
 //! for triangles, the plane test for planes); [`using`](Query::using) names another kernel of
 //! the same primitive and [`culled`](Query::culled) drops back faces, on a slice, a mesh, a

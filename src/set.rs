@@ -7,8 +7,9 @@
 //!   kernel and the culling ([`Query::using`](crate::Query::using),
 //!   [`Query::culled`](crate::Query::culled));
 //! * [`Trace`]: anything a query can run, with its kernel chosen: every [`Set`] (with its
-//!   default kernel), a [`Using`], the focal caches ([`crate::focal`]) and tuples of up to four
-//!   of them, a scene whose hits carry the member's position in [`Hit::set`](crate::Hit::set);
+//!   default kernel), a [`Using`], the focal caches ([`crate::focal`]), tuples of up to four
+//!   of them and [`Sets`] (a slice of them), a scene whose hits carry the member's position in
+//!   [`Hit::set`](crate::Hit::set);
 //! * [`Filtered`]: any of them seen through layer masks and a hit filter
 //!   ([`Screen`]).
 //!
@@ -769,3 +770,104 @@ macro_rules! tuple {
 tuple!(A 0, B 1);
 tuple!(A 0, B 1, C 2);
 tuple!(A 0, B 1, C 2, D 3);
+
+/// A slice of sets as one scene, like a tuple of any length: member `k` is traced as the sets
+/// after those of members `0..k` (its index, for members of one set each, such as
+/// [`Mesh`](crate::mesh::Mesh) or [`FocalMesh`](crate::focal::FocalMesh)), in order; a hit of
+/// a later member wins only when strictly closer (the tie rule's lower set). A mesh split into
+/// parts with a bounding sphere each is one query over the parts:
+///
+/// ```
+/// use raylane::glam::Vec3;
+/// use raylane::mesh::Mesh;
+/// use raylane::set::Sets;
+/// use raylane::{Query, Ray};
+///
+/// let positions = [Vec3::new(-1.0, -1.0, -2.0), Vec3::new(1.0, -1.0, -2.0),
+///                  Vec3::new(0.0, 1.0, -2.0)];
+/// let near = [[0, 1, 2]];
+/// let far: Vec<Vec3> = positions.iter().map(|p| *p - Vec3::Z).collect();
+/// let parts = [Mesh::bounded(&far, &near), Mesh::bounded(&positions, &near)];
+/// let hit = Sets(&parts).closest(&Ray::new(Vec3::ZERO, -Vec3::Z)).unwrap();
+/// assert_eq!((hit.set, hit.index, hit.t), (1, 0, 2.0));
+/// ```
+///
+/// (A slice itself is not a [`Trace`]: `[Sphere]` and `[Triangle]` are sets of primitives.)
+#[derive(Debug)]
+pub struct Sets<'a, T>(pub &'a [T]);
+
+impl<T> Clone for Sets<'_, T> {
+    fn clone(&self) -> Self {
+        *self
+    }
+}
+
+impl<T> Copy for Sets<'_, T> {}
+
+impl<T: Trace> Trace for Sets<'_, T> {
+    const LEVEL_LANES: bool = T::LEVEL_LANES;
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    fn sets(&self) -> u32 {
+        self.0.iter().map(Trace::sets).sum()
+    }
+
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    fn trace<L: Lane, C: Collector<L>>(&self, rays: &RayPacket<L>, set: u32, c: &mut C) -> bool {
+        let mut base = set;
+        for m in self.0 {
+            if m.trace(rays, base, c) {
+                return true;
+            }
+            base += m.sets();
+        }
+        false
+    }
+
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
+    fn trace_ray<C: Collector<f32>>(&self, ray: &Ray, set: u32, c: &mut C) -> bool {
+        let mut base = set;
+        for m in self.0 {
+            if m.trace_ray(ray, base, c) {
+                return true;
+            }
+            base += m.sets();
+        }
+        false
+    }
+
+    fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
+        // One pass over the members, asking only those that own a winner: `next` is the
+        // lowest set among the winners not yet recorded.
+        let lowest = |mask: L::Mask| {
+            let mut bits = mask.bits();
+            let mut low = u32::MAX;
+            while bits != 0 {
+                let i = bits.trailing_zeros() as usize;
+                bits &= bits - 1;
+                low = low.min(w.set.as_ref().get(i).copied().unwrap_or(u32::MAX));
+            }
+            low
+        };
+        let mut out = Hits::miss();
+        let mut left = w.mask;
+        let mut next = lowest(left);
+        let mut base = set;
+        for m in self.0 {
+            if !left.any() {
+                break;
+            }
+            let n = m.sets();
+            if next.wrapping_sub(base) < n {
+                let own = owned(w, base, n);
+                out = select_hits(own.mask, &m.records(rays, base, &own), &out);
+                left = left.and_not(own.mask);
+                next = lowest(left);
+            }
+            base += n;
+        }
+        out
+    }
+}

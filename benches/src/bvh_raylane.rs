@@ -22,10 +22,9 @@ use glam::Vec3;
 use raylane::bvh::{self, Bvh, Leaf, Node, Primitives, Scratch, Sphere4, Tri4};
 use raylane::focal::FocalMesh;
 use raylane::mesh::Mesh;
-use raylane::sphere::{Robust, Sphere};
+use raylane::set::Sets;
+use raylane::sphere::Sphere;
 use raylane::{Lane, Mask, Pinhole, Query, Ray, RayPacket};
-use raylane_lab::loops as internals;
-use raylane_lab::loops::LaneRecords;
 
 use crate::meshes::Answers;
 
@@ -45,8 +44,8 @@ pub fn packets<L: Lane<Scalar = f32>>(rays: &[Ray]) -> Vec<RayPacket<L>> {
     rays.chunks(L::LANES).map(RayPacket::from_rays).collect()
 }
 
-/// Closest hits over the parts with `Watertight`; `ids[p][i]` is the input index of triangle
-/// `i` of part `p`.
+/// Closest hits over the parts with `Watertight`, one query per packet over the parts
+/// ([`Sets`]); `ids[p][i]` is the input index of triangle `i` of part `p`.
 #[inline(never)]
 pub fn closest<L: Lane<Scalar = f32>>(
     packets: &[RayPacket<L>],
@@ -57,26 +56,13 @@ pub fn closest<L: Lane<Scalar = f32>>(
 ) -> u32 {
     let mut n = 0;
     for p in packets {
-        let mut r = *black_box(p);
-        let mut best = [None; 16];
-        let mut mask = L::Mask::splat(false);
-        for (k, m) in meshes.iter().enumerate() {
-            let h = m.closest(&r);
-            if h.mask.any() {
-                r = r.shrink(h.mask, h.t);
-                mask = mask | h.mask;
-                if out.is_some() {
-                    for (i, b) in best.iter_mut().enumerate().take(L::LANES) {
-                        if let Some(rec) = h.lane(i) {
-                            *b = Some((rec.t, ids[k][rec.index as usize]));
-                        }
-                    }
-                }
-            }
-        }
-        n += mask.bits().count_ones();
+        let h = Sets(meshes).closest(black_box(p));
+        n += h.mask.bits().count_ones();
         if let Some(o) = out.as_deref_mut() {
-            o.extend_from_slice(&best[..L::LANES]);
+            o.extend((0..L::LANES).map(|i| {
+                h.lane(i)
+                    .map(|r| (r.t, ids[r.set as usize][r.index as usize]))
+            }));
         }
     }
     if let Some(o) = out {
@@ -85,7 +71,8 @@ pub fn closest<L: Lane<Scalar = f32>>(
     n
 }
 
-/// Any hit over the parts with `Watertight` (lanes found occluded drop out of later parts).
+/// Any hit over the parts with `Watertight`, one query per packet over the parts (it stops
+/// when every lane is occluded).
 #[inline(never)]
 pub fn any<L: Lane<Scalar = f32>>(
     packets: &[RayPacket<L>],
@@ -94,21 +81,8 @@ pub fn any<L: Lane<Scalar = f32>>(
     mut out: Option<&mut Answers>,
 ) -> u32 {
     let mut n = 0;
-    let gone = L::from_f32(f32::NEG_INFINITY);
     for p in packets {
-        let mut r = *black_box(p);
-        let live = r.valid();
-        let mut occ = L::Mask::splat(false);
-        for m in meshes {
-            let h = m.any(&r);
-            if h.any() {
-                occ = occ | h;
-                if (occ | !live).all() {
-                    break;
-                }
-                r = r.shrink(h, gone);
-            }
-        }
+        let occ = Sets(meshes).any(black_box(p));
         n += occ.bits().count_ones();
         if let Some(o) = out.as_deref_mut() {
             o.extend((0..L::LANES).map(|i| occ.test(i).then_some((0.0, 0))));
@@ -143,7 +117,7 @@ pub fn spheres_closest<L: Lane<Scalar = f32>>(
 ) -> u32 {
     let mut n = 0;
     for p in packets {
-        let h = internals::sphere::closest::<Robust, L>(black_box(p), spheres);
+        let h = spheres.closest(black_box(p));
         n += h.mask.bits().count_ones();
         if let Some(o) = out.as_deref_mut() {
             o.extend((0..L::LANES).map(|i| h.lane(i).map(|r| (r.t, r.index))));

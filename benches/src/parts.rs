@@ -12,11 +12,11 @@ use std::hint::black_box;
 
 use glam::Vec3;
 use raylane::focal::FocalMesh;
-use raylane::hit::{Closest, Winners};
+use raylane::hit::Hits;
 use raylane::mesh::Mesh;
-use raylane::set::Trace;
+use raylane::set::Sets;
 use raylane::triangle::{FocalTriangle, Triangle};
-use raylane::{Lane, Mask, RayPacket};
+use raylane::{Lane, Mask, Query, RayPacket};
 
 /// Triangles in parts, each part its own vertex and index arrays (unshared vertices).
 pub struct Parts {
@@ -131,15 +131,12 @@ fn split(
     split(r, size, centroid, groups);
 }
 
-/// The closest hit of one packet of rays from the meshes' eye over every part.
+/// The closest hit of one packet of rays from the meshes' eye over every part: one query over
+/// the parts ([`Sets`]), each part's bounding sphere first, then its triangles; ties keep the
+/// earlier part.
 #[inline(always)]
-fn closest<L: Lane>(rays: &RayPacket<L>, meshes: &[FocalMesh]) -> Winners<L> {
-    let mut c = Closest::new(rays);
-    for (k, m) in meshes.iter().enumerate() {
-        // The bounding sphere first, then the triangles; ties keep the earlier part.
-        m.trace(rays, k as u32, &mut c);
-    }
-    c.finish()
+fn closest<L: Lane>(rays: &RayPacket<L>, meshes: &[FocalMesh]) -> Hits<L> {
+    Sets(meshes).closest(rays)
 }
 
 /// One frame: the closest hit of every packet over the parts; returns the number of lanes hit.

@@ -353,6 +353,58 @@ fn mesh_and_focal_mesh_queries_every_lane_equals_one_ray() {
 }
 
 #[test]
+fn sets_of_parts_equal_the_whole_mesh() {
+    use raylane::mesh::Mesh;
+    use raylane::set::Sets;
+    let m = load_bin(include_bytes!("../../data/bunny.bin"));
+    // Consecutive runs of the triangles, each a bounded mesh over the shared vertices; one
+    // empty part (no bound, no triangle).
+    let mut starts = vec![0usize];
+    for len in [1, 0, 7, 100, 500, 33].into_iter().cycle() {
+        let s = *starts.last().unwrap();
+        if s + len >= m.idx.len() {
+            break;
+        }
+        starts.push(s + len);
+    }
+    starts.push(m.idx.len());
+    let parts: Vec<Mesh> = starts
+        .windows(2)
+        .map(|w| Mesh::bounded(&m.pos, &m.idx[w[0]..w[1]]))
+        .collect();
+    // The same parts as groups of three (a member owning several sets).
+    let groups: Vec<Sets<Mesh>> = parts.chunks(3).map(Sets).collect();
+    let whole = Mesh::bounded(&m.pos, &m.idx);
+    let (lo, hi) = m
+        .pos
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
+            (l.min(*p), h.max(*p))
+        });
+    let (c, size) = ((lo + hi) / 2.0, (hi - lo).length() / 2.0);
+    let mut rng = SmallRng::seed_from_u64(32);
+    let rays: Vec<Ray> = (0..160).map(|_| ray(&mut rng, c, size)).collect();
+    let want = every_width(&whole, &rays, "whole mesh");
+    let got = every_width(&Sets(&parts), &rays, "parts");
+    assert!(got.iter().flatten().map(|h| h.set).max() > Some(3));
+    let as_whole = |h: Option<Hit>| {
+        h.map(|h| Hit {
+            index: starts[h.set as usize] as u32 + h.index,
+            set: 0,
+            ..h
+        })
+    };
+    for (w, g) in want.iter().zip(&got) {
+        assert_eq!(bits(as_whole(*g)), bits(*w));
+    }
+    let nested = every_width(&Sets(&groups), &rays, "groups of parts");
+    assert_eq!(
+        nested.iter().map(|h| bits(*h)).collect::<Vec<_>>(),
+        got.iter().map(|h| bits(*h)).collect::<Vec<_>>()
+    );
+}
+
+#[test]
 fn focal_spheres_and_planes_answer_every_ray() {
     use raylane::Dir;
     use raylane::focal::FocalPlanes;
