@@ -838,6 +838,8 @@ impl<T: Trace> Trace for Sets<'_, T> {
         false
     }
 
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
+    #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
         // One pass over the members, asking only those that own a winner: `next` is the
         // lowest set among the winners not yet recorded.
