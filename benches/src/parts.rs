@@ -12,7 +12,6 @@ use std::hint::black_box;
 
 use glam::Vec3;
 use raylane::focal::FocalMesh;
-use raylane::hit::Hits;
 use raylane::mesh::Mesh;
 use raylane::set::Sets;
 use raylane::triangle::{FocalTriangle, Triangle};
@@ -131,20 +130,14 @@ fn split(
     split(r, size, centroid, groups);
 }
 
-/// The closest hit of one packet of rays from the meshes' eye over every part: one query over
-/// the parts ([`Sets`]), each part's bounding sphere first, then its triangles; ties keep the
-/// earlier part.
-#[inline(always)]
-fn closest<L: Lane>(rays: &RayPacket<L>, meshes: &[FocalMesh]) -> Hits<L> {
-    Sets(meshes).closest(rays)
-}
-
-/// One frame: the closest hit of every packet over the parts; returns the number of lanes hit.
+/// One frame: the closest hit of every packet over the parts, one query over them ([`Sets`]:
+/// each part's bounding sphere first, then its triangles; ties keep the earlier part); returns
+/// the number of lanes hit.
 #[inline(never)]
 pub fn frame<L: Lane>(packets: &[RayPacket<L>], meshes: &[FocalMesh]) -> u32 {
     let mut n = 0;
     for p in packets {
-        let h = closest(black_box(p), meshes);
+        let h = Sets(meshes).closest(black_box(p));
         n += h.mask.bits().count_ones();
         black_box(&h);
     }
@@ -160,7 +153,7 @@ pub fn answers<L: Lane<Scalar = f32>>(
     packets
         .iter()
         .flat_map(|p| {
-            let h = closest(p, meshes);
+            let h = Sets(meshes).closest(p);
             (0..L::LANES).map(move |i| h.mask.test(i).then(|| h.t.lane(i)))
         })
         .take(rays)

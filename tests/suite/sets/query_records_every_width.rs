@@ -161,6 +161,16 @@ fn every_width<Q: Query + ?Sized>(q: &Q, rays: &[Ray], what: &str) -> Vec<Option
     one
 }
 
+/// The centre of the points' bounding box and half its diagonal: what [`ray`] aims around.
+fn around(pos: &[Vec3]) -> (Vec3, f32) {
+    let (lo, hi) = pos
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
+            (l.min(*p), h.max(*p))
+        });
+    ((lo + hi) / 2.0, (hi - lo).length() / 2.0)
+}
+
 fn spheres(rng: &mut SmallRng, n: usize) -> Vec<Sphere> {
     (0..n)
         .map(|_| {
@@ -212,13 +222,7 @@ fn triangle_queries_every_lane_equals_one_ray() {
             )
         })
         .collect();
-    let (lo, hi) = m
-        .pos
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
-            (l.min(*p), h.max(*p))
-        });
-    let (c, size) = ((lo + hi) / 2.0, (hi - lo).length() / 2.0);
+    let (c, size) = around(&m.pos);
     let mut rng = SmallRng::seed_from_u64(12);
     let mut rays: Vec<Ray> = (0..160).map(|_| ray(&mut rng, c, size)).collect();
     // Some from inside the body: back faces.
@@ -306,13 +310,7 @@ fn mesh_and_focal_mesh_queries_every_lane_equals_one_ray() {
     let mesh = Mesh::new(&m.pos, &idx);
     assert_eq!(mesh.invalid(), 2);
     let bounded = Mesh::bounded(&m.pos, &idx);
-    let (lo, hi) = m
-        .pos
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
-            (l.min(*p), h.max(*p))
-        });
-    let (c, size) = ((lo + hi) / 2.0, (hi - lo).length() / 2.0);
+    let (c, size) = around(&m.pos);
     let mut rng = SmallRng::seed_from_u64(14);
     let rays: Vec<Ray> = (0..120).map(|_| ray(&mut rng, c, size)).collect();
     let want = every_width(&tris[..], &rays, "triangles");
@@ -375,13 +373,7 @@ fn sets_of_parts_equal_the_whole_mesh() {
     // The same parts as groups of three (a member owning several sets).
     let groups: Vec<Sets<Mesh>> = parts.chunks(3).map(Sets).collect();
     let whole = Mesh::bounded(&m.pos, &m.idx);
-    let (lo, hi) = m
-        .pos
-        .iter()
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), p| {
-            (l.min(*p), h.max(*p))
-        });
-    let (c, size) = ((lo + hi) / 2.0, (hi - lo).length() / 2.0);
+    let (c, size) = around(&m.pos);
     let mut rng = SmallRng::seed_from_u64(32);
     let rays: Vec<Ray> = (0..160).map(|_| ray(&mut rng, c, size)).collect();
     let want = every_width(&whole, &rays, "whole mesh");
