@@ -11,10 +11,13 @@
 
 use std::hint::black_box;
 
-use raylane::Query;
-use raylane::bvh::{OwnedBvh, Tri4};
+use raylane::bvh::{Bvh, OwnedBvh, Tri4};
+use raylane::hit::Closest;
 use raylane::mesh::Mesh;
+use raylane::set::Trace;
+use raylane::simd::{self, Packets};
 use raylane::triangle::Moller;
+use raylane::{Lane, Mask, Pinhole, Query, Ray, RayPacket};
 use raylane_bench::bvh_peers::{EmbreeBvh, EmbreeRays};
 use raylane_bench::bvh_raylane as rl;
 use raylane_bench::meshes::{self, SurfaceHit, Workload};
@@ -87,6 +90,21 @@ fn measure() {
     run("primary raylane BVH tiles 16×16 x16", p.len(), &|| {
         rl::bvh_tiles::<f32x16, 16>(&tree, cam, (0, 1), None)
     });
+    // Where a primary packet's instructions go: the same blocks of 16 at the SIMD level, made
+    // from the camera alone, traced without records, and traced with records.
+    for part in [Part::Rays, Part::Load, Part::Trace, Part::Records] {
+        run(part.name(), p.len(), &|| {
+            simd::with_lanes(
+                16,
+                Split {
+                    tree: &tree,
+                    cam,
+                    rays: p,
+                    part,
+                },
+            )
+        });
+    }
     let m = tree.using::<Moller>();
     run("primary raylane BVH Möller x1", p.len(), &|| {
         rl::bvh_closest1(&m, p, None)
@@ -134,6 +152,81 @@ fn measure() {
     run("shadow Embree rtcOccluded8", s.len(), &|| {
         ebr.occluded8(&es, None)
     });
+}
+
+/// What [`Split`] runs for each block of 16 primary rays.
+#[derive(Clone, Copy)]
+enum Part {
+    /// The block's rays made from the camera (`Pinhole::block_packet`).
+    Rays,
+    /// The block's rays loaded from the frame's rays (`RayPacket::from_rays`), what the next
+    /// two parts start with.
+    Load,
+    /// The block traced into a closest-hit collector (`Trace::trace`), no records.
+    Trace,
+    /// The same, then the winners' records (`Trace::records`).
+    Records,
+}
+
+impl Part {
+    fn name(self) -> &'static str {
+        match self {
+            Part::Rays => "primary raylane x16 split: rays made from the camera",
+            Part::Load => "primary raylane x16 split: rays loaded",
+            Part::Trace => "primary raylane x16 split: rays loaded, BVH traced, no records",
+            Part::Records => "primary raylane x16 split: rays loaded, BVH traced, records",
+        }
+    }
+}
+
+/// A primary frame's blocks of 16 at the SIMD level, in parts (see [`Part`]): the BVH x16
+/// row's instructions are the traced packets', their records', and the query's entry.
+struct Split<'a> {
+    tree: &'a Bvh<'a, Tri4>,
+    cam: &'a Pinhole,
+    rays: &'a [Ray],
+    part: Part,
+}
+
+impl Packets for Split<'_> {
+    type Output = u32;
+    #[inline(always)]
+    fn run<L: Lane<Scalar = f32>>(self) -> u32 {
+        let mut n = 0;
+        match self.part {
+            Part::Rays => {
+                let (w, h) = (self.cam.width / 4, self.cam.height / 4);
+                for k in 0..w * h {
+                    let r = self.cam.block_packet::<L>((k % w) * 4, (k / w) * 4);
+                    black_box(&r);
+                    n += 1;
+                }
+            }
+            Part::Load => {
+                for chunk in self.rays.chunks(16) {
+                    black_box(RayPacket::<L>::from_rays(chunk));
+                    n += 1;
+                }
+            }
+            Part::Trace | Part::Records => {
+                for chunk in self.rays.chunks(16) {
+                    let r = black_box(RayPacket::<L>::from_rays(chunk));
+                    let mut c = Closest::new(&r);
+                    self.tree.trace(&r, 0, &mut c);
+                    let w = c.finish();
+                    if let Part::Records = self.part {
+                        let h = self.tree.records(&r, 0, &w);
+                        n += h.mask.bits().count_ones();
+                        black_box(&h);
+                    } else {
+                        black_box(&w);
+                        n += 1;
+                    }
+                }
+            }
+        }
+        n
+    }
 }
 
 /// `words` as its first `len` bytes.
