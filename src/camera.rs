@@ -123,19 +123,45 @@ impl Pinhole {
         // Column and row of lane i, in u64 so that they cannot wrap (x, y ≤ u32::MAX, i < 2^32).
         let col = |i: usize| u64::from(x) + offset(i, w).0 as u64;
         let row = |i: usize| u64::from(y) + offset(i, w).1 as u64;
-        let px = L::from_f32_fn(|i| col(i) as f32 + 0.5);
-        let py = L::from_f32_fn(|i| row(i) as f32 + 0.5);
+        let h = L::LANES.div_ceil(w);
+        // A packet inside the image (so below 2^24 in both coordinates, where every integer
+        // is an f32): its columns are `x + (i mod w)` added as f32 (exact, so the same bits
+        // as lane by lane), and every lane is inside.
+        let whole = u64::from(x) + w as u64 <= u64::from(self.width)
+            && u64::from(y) + h as u64 <= u64::from(self.height)
+            && self.width <= 1 << 24
+            && self.height <= 1 << 24;
+        let (px, py) = if whole {
+            let (dx, dy) = (
+                L::from_f32_fn(|i| offset(i, w).0 as f32),
+                L::from_f32_fn(|i| offset(i, w).1 as f32),
+            );
+            let half = L::from_f32(0.5);
+            (
+                (L::from_f32(x as f32) + dx) + half,
+                (L::from_f32(y as f32) + dy) + half,
+            )
+        } else {
+            (
+                L::from_f32_fn(|i| col(i) as f32 + 0.5),
+                L::from_f32_fn(|i| row(i) as f32 + 0.5),
+            )
+        };
         let corner = V3::<L>::splat(self.corner);
         let target = corner + V3::splat(self.du).scale(px) + V3::splat(self.dv).scale(py);
         let d = target - V3::splat(self.eye);
         let dir = d.div_by(d.length_squared().sqrt());
-        let inside = L::from_f32_fn(|i| {
-            if col(i) < u64::from(self.width) && row(i) < u64::from(self.height) {
-                f32::INFINITY
-            } else {
-                0.0
-            }
-        });
+        let inside = if whole {
+            L::from_f32(f32::INFINITY)
+        } else {
+            L::from_f32_fn(|i| {
+                if col(i) < u64::from(self.width) && row(i) < u64::from(self.height) {
+                    f32::INFINITY
+                } else {
+                    0.0
+                }
+            })
+        };
         RayPacket::new(V3::splat(self.eye), dir, L::from_f32(0.0), inside)
     }
 }

@@ -414,8 +414,8 @@ impl Trace for FocalSpheres<'_> {
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
-        Sphere::records(rays, &mine(w, set), self.cull, |i| {
-            self.spheres.get(w.loc(i)? as usize).copied()
+        Sphere::records(rays, &mine(w, set), self.cull, |loc| {
+            self.spheres.get(loc as usize).copied()
         })
     }
 }
@@ -527,8 +527,8 @@ impl Trace for FocalPlanes<'_> {
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     #[cfg_attr(not(target_arch = "x86_64"), inline)]
     fn records<L: Lane>(&self, rays: &RayPacket<L>, set: u32, w: &Winners<L>) -> Hits<L> {
-        Plane::records(rays, &mine(w, set), self.cull, |i| {
-            self.planes.get(w.loc(i)? as usize).copied()
+        Plane::records(rays, &mine(w, set), self.cull, |loc| {
+            self.planes.get(loc as usize).copied()
         })
     }
 }

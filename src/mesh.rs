@@ -239,7 +239,7 @@ impl Set for Mesh<'_> {
             &mine(w, set),
             cull,
             #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |i| Some(self.prepared(w.loc(i)? as usize)),
+            |loc| Some(self.prepared(loc as usize)),
         )
     }
 }

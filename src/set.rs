@@ -585,7 +585,7 @@ impl Set for [Sphere] {
             &mine(w, set),
             cull,
             #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |i| self.get(w.loc(i)? as usize).copied(),
+            |loc| self.get(loc as usize).copied(),
         )
     }
 }
@@ -619,7 +619,7 @@ impl Set for [Triangle] {
             &mine(w, set),
             cull,
             #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |i| self.get(w.loc(i)? as usize).copied(),
+            |loc| self.get(loc as usize).copied(),
         )
     }
 }
@@ -653,7 +653,7 @@ impl Set for [Plane] {
             &mine(w, set),
             cull,
             #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |i| self.get(w.loc(i)? as usize).copied(),
+            |loc| self.get(loc as usize).copied(),
         )
     }
 }

@@ -695,7 +695,7 @@ impl Set for Baked<'_> {
             &mine(w, set),
             cull,
             #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |i| Some(self.triangle(w.loc(i)? as usize)),
+            |loc| Some(self.triangle(loc as usize)),
         )
     }
 }

@@ -737,8 +737,8 @@ impl<P: Leaf, N: Layout> Set for Bvh<'_, P, N> {
             &mine(w, set),
             cull,
             #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |i| {
-                let loc = w.loc(i)? as usize;
+            |loc| {
+                let loc = loc as usize;
                 Some(self.leaves.get(loc / LEAF_WIDTH)?.prim(loc % LEAF_WIDTH))
             },
         )
