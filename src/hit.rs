@@ -945,10 +945,14 @@ impl Record for Sphere {
         if w.mask.none() {
             return Hits::miss();
         }
-        let [x, y, z] = gather(w, [0.0; 3], |loc| {
-            sphere(loc).map(|s| s.center().to_array())
-        });
-        let c = V3::new(x, y, z);
+        let c = if L::LANES == 1 {
+            V3::splat(lone(w).and_then(sphere).map_or(Vec3::ZERO, |s| s.center()))
+        } else {
+            let rows = gather(w, [0.0; 3], |loc| {
+                sphere(loc).map(|s| s.center().to_array())
+            });
+            V3::new(row(&rows, 0), row(&rows, 1), row(&rows, 2))
+        };
         let point = rays.origin.along(rays.dir, w.t);
         let n = unit(point - c, w.mask, |i| {
             let (o, d, c) = (
@@ -978,16 +982,21 @@ impl Record for Triangle {
         if w.mask.none() {
             return Hits::miss();
         }
-        let [ax, ay, az, bx, by, bz, cx, cy, cz] = gather(w, [f32::NAN; 9], |loc| {
-            tri(loc).map(|t| {
-                let (a, b, c) = (t.a(), t.b(), t.c());
-                [a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z]
-            })
-        });
-        let p = TrianglePacket {
-            a: V3::new(ax, ay, az),
-            b: V3::new(bx, by, bz),
-            c: V3::new(cx, cy, cz),
+        let p = if L::LANES == 1 {
+            TrianglePacket::splat(&lone(w).and_then(tri).unwrap_or(Triangle::never()))
+        } else {
+            let rows = gather(w, [f32::NAN; 9], |loc| {
+                tri(loc).map(|t| {
+                    let (a, b, c) = (t.a(), t.b(), t.c());
+                    [a.x, a.y, a.z, b.x, b.y, b.z, c.x, c.y, c.z]
+                })
+            });
+            let v = |k: usize| V3::new(row(&rows, k), row(&rows, k + 1), row(&rows, k + 2));
+            TrianglePacket {
+                a: v(0),
+                b: v(3),
+                c: v(6),
+            }
         };
         let n = unit((p.b - p.a).cross(p.c - p.a), w.mask, |i| {
             let (a, b, c) = (
@@ -1020,8 +1029,12 @@ impl Record for Plane {
         if w.mask.none() {
             return Hits::miss();
         }
-        let [x, y, z] = gather(w, [0.0; 3], |loc| plane(loc).map(|p| p.normal.to_array()));
-        let normal = V3::new(x, y, z);
+        let normal = if L::LANES == 1 {
+            V3::splat(lone(w).and_then(plane).map_or(Vec3::ZERO, |p| p.normal))
+        } else {
+            let rows = gather(w, [0.0; 3], |loc| plane(loc).map(|p| p.normal.to_array()));
+            V3::new(row(&rows, 0), row(&rows, 1), row(&rows, 2))
+        };
         let n = unit(normal, w.mask, |i| normal.precise_lane(i));
         let point = rays.origin.along(rays.dir, w.t);
         let front = if cull.back() {
@@ -1033,27 +1046,18 @@ impl Record for Plane {
     }
 }
 
-/// `N` values per lane of `w` as `N` lane values: `f(loc)` for each lane of `w.mask` (one
-/// pass over its set lanes, the others never asked; `loc` is the lane's `w.loc`), `default`
-/// where `f` gives `None` or the lane is outside the mask. A packet's records gather their winners' primitives with it
-/// (callgrind, x86-64-v3, the vendored bunny's primary rays in packets of 16: asking every
-/// lane cost about 20 more instructions per ray).
+/// `N` values per lane of `w`, as rows of lanes ([`row`]): `f(loc)` for each lane of
+/// `w.mask` (one pass over its set lanes, the others never asked; `loc` is the lane's `w.loc`),
+/// `default` where `f` gives `None` or the lane is outside the mask. A packet's records gather
+/// their winners' primitives with it (callgrind, x86-64-v3, the vendored bunny's primary rays
+/// in packets of 16: asking every lane cost about 10 more instructions per ray); one lane
+/// takes its own ([`lone`]: no rows to fill).
 #[inline(always)]
 fn gather<L: Lane, const N: usize>(
     w: &Winners<L>,
     default: [f32; N],
     mut f: impl FnMut(u32) -> Option<[f32; N]>,
-) -> [L; N] {
-    let mut out = [L::from_f32(0.0); N];
-    if L::LANES == 1 {
-        // One lane: its values themselves (no rows to fill).
-        let loc = w.loc.as_ref().first().copied();
-        let v = loc.filter(|_| w.mask.any()).and_then(f).unwrap_or(default);
-        for (o, x) in out.iter_mut().zip(v) {
-            *o = L::from_f32(x);
-        }
-        return out;
-    }
+) -> [[f32; MAX_LANES]; N] {
     let mut rows = [[0f32; MAX_LANES]; N];
     for (row, d) in rows.iter_mut().zip(default) {
         *row = [d; MAX_LANES];
@@ -1070,10 +1074,19 @@ fn gather<L: Lane, const N: usize>(
             }
         }
     }
-    for (o, row) in out.iter_mut().zip(&rows) {
-        *o = L::from_f32_fn(|i| row[i]);
-    }
-    out
+    rows
+}
+
+/// The `loc` of a one-lane `w`'s winner, if it hit.
+#[inline(always)]
+fn lone<L: Lane>(w: &Winners<L>) -> Option<u32> {
+    w.loc.as_ref().first().copied().filter(|_| w.mask.any())
+}
+
+/// Row `k` of [`gather`]'s rows as lanes.
+#[inline(always)]
+fn row<L: Lane, const N: usize>(rows: &[[f32; MAX_LANES]; N], k: usize) -> L {
+    L::from_f32_fn(|i| rows[k][i])
 }
 
 /// The records from the winners and their point, normal and face.
