@@ -946,7 +946,7 @@ impl Record for Sphere {
             return Hits::miss();
         }
         let c = if L::LANES == 1 {
-            V3::splat(lone(w).and_then(sphere).map_or(Vec3::ZERO, |s| s.center()))
+            V3::splat(w.loc(0).and_then(sphere).map_or(Vec3::ZERO, |s| s.center()))
         } else {
             let rows = gather(w, [0.0; 3], |loc| {
                 sphere(loc).map(|s| s.center().to_array())
@@ -983,7 +983,7 @@ impl Record for Triangle {
             return Hits::miss();
         }
         let p = if L::LANES == 1 {
-            TrianglePacket::splat(&lone(w).and_then(tri).unwrap_or(Triangle::never()))
+            TrianglePacket::splat(&w.loc(0).and_then(tri).unwrap_or(Triangle::never()))
         } else {
             let rows = gather(w, [f32::NAN; 9], |loc| {
                 tri(loc).map(|t| {
@@ -1030,7 +1030,7 @@ impl Record for Plane {
             return Hits::miss();
         }
         let normal = if L::LANES == 1 {
-            V3::splat(lone(w).and_then(plane).map_or(Vec3::ZERO, |p| p.normal))
+            V3::splat(w.loc(0).and_then(plane).map_or(Vec3::ZERO, |p| p.normal))
         } else {
             let rows = gather(w, [0.0; 3], |loc| plane(loc).map(|p| p.normal.to_array()));
             V3::new(row(&rows, 0), row(&rows, 1), row(&rows, 2))
@@ -1051,7 +1051,7 @@ impl Record for Plane {
 /// `default` where `f` gives `None` or the lane is outside the mask. A packet's records gather
 /// their winners' primitives with it (callgrind, x86-64-v3, the vendored bunny's primary rays
 /// in packets of 16: asking every lane cost about 10 more instructions per ray); one lane
-/// takes its own ([`lone`]: no rows to fill).
+/// takes its own ([`Winners::loc`]: no rows to fill).
 #[inline(always)]
 fn gather<L: Lane, const N: usize>(
     w: &Winners<L>,
@@ -1075,12 +1075,6 @@ fn gather<L: Lane, const N: usize>(
         }
     }
     rows
-}
-
-/// The `loc` of a one-lane `w`'s winner, if it hit.
-#[inline(always)]
-fn lone<L: Lane>(w: &Winners<L>) -> Option<u32> {
-    w.loc.as_ref().first().copied().filter(|_| w.mask.any())
 }
 
 /// Row `k` of [`gather`]'s rows as lanes.
