@@ -462,36 +462,40 @@ impl Slab {
         let span = reach + omax;
         let all = !(span <= FAR && (D_LO..=D_HI).contains(&dmax));
         let m = span * MARGIN;
-        let mut s = Slab {
-            near: [0, 1, 2],
-            far: [3, 4, 5],
-            on: [0.0; 3],
-            of: [0.0; 3],
-            inv: [0.0; 3],
-            qn: [0.0; 3],
-            qf: [0.0; 3],
-            all,
+        // The three axes in the lanes of one `f32x4` (lane 3 unused): the same operations
+        // as one axis at a time, so the same bits. `+ 0` makes −0 positive, so the plane
+        // choice and the inverse's sign agree.
+        let zero = f32x4::splat(0.0);
+        let da = f32x4::new([d[0], d[1], d[2], 1.0]) + zero;
+        let neg = Lane::lt(da, zero);
+        let inv =
+            (f32x4::splat(1.0) / da).fast_clamp(f32x4::splat(-INV_MAX), f32x4::splat(INV_MAX));
+        // `±m` (a sign flip, exact), so `o + ms` and `o − ms` are `o ± m` bit for bit; a
+        // select rather than branches (an incoherent ray's signs are unpredictable).
+        let ms = Lane::select(neg, f32x4::splat(-m), f32x4::splat(m));
+        let o4 = f32x4::new([o[0], o[1], o[2], 0.0]);
+        let (on, of) = (o4 + ms, o4 - ms);
+        let (qn, qf) = if FUSED {
+            (on * inv, of * inv)
+        } else {
+            (zero, zero)
         };
-        for a in 0..3 {
-            // `+ 0` makes −0 positive, so the plane choice and the inverse's sign agree.
-            let da = d[a] + 0.0;
-            let neg = da < 0.0;
-            s.inv[a] = (1.0 / da).clamp(-INV_MAX, INV_MAX);
-            // Arithmetic rather than branches or selects (which the compiler may turn into
-            // branches): the sign of an incoherent ray's direction is unpredictable. `ms` is
-            // `±m` (a sign flip, exact), so `o + ms` and `o − ms` are `o ± m` bit for bit.
-            let k = neg as usize;
-            let ms = f32::from_bits(m.to_bits() ^ ((neg as u32) << 31));
-            s.near[a] = a + 3 * k;
-            s.far[a] = 3 + a - 3 * k;
-            s.on[a] = o[a] + ms;
-            s.of[a] = o[a] - ms;
-            if FUSED {
-                s.qn[a] = s.on[a] * s.inv[a];
-                s.qf[a] = s.of[a] * s.inv[a];
-            }
+        let bits = neg.bits();
+        let three = |v: f32x4| {
+            let v = v.to_array();
+            [v[0], v[1], v[2]]
+        };
+        let k = |a: usize| (bits >> a & 1) as usize;
+        Slab {
+            near: [3 * k(0), 1 + 3 * k(1), 2 + 3 * k(2)],
+            far: [3 - 3 * k(0), 4 - 3 * k(1), 5 - 3 * k(2)],
+            on: three(on),
+            of: three(of),
+            inv: three(inv),
+            qn: three(qn),
+            qf: three(qf),
+            all,
         }
-        s
     }
 
     /// Bit `k` set when the ray's interval `(t_min, t_max)` meets the widened box of child `k`
