@@ -147,6 +147,33 @@ pub trait Kernel<P: Primitive> {
         prim: &P::Packet<L>,
         cull: Cull,
     ) -> Option<LaneHit<L>>;
+    /// [`first`](Self::first) for one ray, the same in every lane of `rays`, against the
+    /// primitives `load(order)` gives, their coordinates in the axis order `order`: a kernel
+    /// whose per-ray constants permute the axes ([`Watertight`](crate::triangle::Watertight))
+    /// asks for its order, so that the primitives are loaded permuted once for all lanes
+    /// rather than selected lane by lane (the same values, so the same bits). By default
+    /// [`first`](Self::first) on `load(XYZ)`.
+    #[inline(always)]
+    fn first_one<L: Lane>(
+        rays: &RayPacket<L>,
+        pre: &Self::Rays<L>,
+        load: impl FnOnce([usize; 3]) -> P::Packet<L>,
+        cull: Cull,
+    ) -> Option<LaneHit<L>> {
+        Self::first(rays, pre, &load(XYZ), cull)
+    }
+    /// [`each`](Self::each) for one ray, as [`first_one`](Self::first_one) is
+    /// [`first`](Self::first).
+    #[inline(always)]
+    fn each_one<L: Lane>(
+        rays: &RayPacket<L>,
+        pre: &Self::Rays<L>,
+        load: impl FnOnce([usize; 3]) -> P::Packet<L>,
+        cull: Cull,
+        f: impl FnMut(&LaneHit<L>) -> bool,
+    ) -> bool {
+        Self::each(rays, pre, &load(XYZ), cull, f)
+    }
     /// Every hit, in order along the rays (spheres: the entry roots, then, unless culled, the
     /// exit roots with `u = 1`), each passed to `f`; stops when `f` returns true, and returns
     /// whether it stopped. By default the [`first`](Self::first) hit alone.
@@ -161,6 +188,9 @@ pub trait Kernel<P: Primitive> {
         Self::first(rays, pre, prim, cull).is_some_and(|h| h.mask.any() && f(&h))
     }
 }
+
+/// The axis order x, y, z (see [`Kernel::first_one`]).
+pub const XYZ: [usize; 3] = [0, 1, 2];
 
 /// Whether a kernel can answer `ray`: for kernels that need unit directions, false when
 /// `|d|²` is more than [`UNIT_TOLERANCE`] from 1 ([`admit`] for one ray: such a ray misses).

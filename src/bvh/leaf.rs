@@ -6,7 +6,7 @@ use wide::f32x4;
 
 use super::{EMPTY, LEAF_WIDTH, max, min};
 use crate::hit::Record;
-use crate::kernel::{Kernel, Primitive};
+use crate::kernel::{Kernel, Primitive, XYZ};
 use crate::lane::Lane;
 use crate::mesh::Mesh;
 use crate::sphere::{Robust, Sphere, SpherePacket};
@@ -36,8 +36,9 @@ pub trait Leaf: Packed {
     fn prim(&self, k: usize) -> Self::Prim;
     /// Lane `k`'s primitive in every lane (N rays × 1 primitive).
     fn splat<L: Lane>(&self, k: usize) -> <Self::Prim as Primitive>::Packet<L>;
-    /// The leaf's primitives in `f32x4` lanes (1 ray × 4 primitives).
-    fn four(&self) -> <Self::Prim as Primitive>::Packet<f32x4>;
+    /// The leaf's primitives in `f32x4` lanes (1 ray × 4 primitives), their coordinates in
+    /// the axis order `order` (`XYZ`: x, y, z; what [`Kernel::first_one`] asks for).
+    fn four(&self, order: [usize; 3]) -> <Self::Prim as Primitive>::Packet<f32x4>;
     /// The boxes of the lanes' primitives that can be hit, as [`Packed::bounds`] gives them
     /// (rows minimum x, y, z, maximum x, y, z; a primitive per lane), for a packet's cull.
     fn boxes(&self) -> [f32x4; 6];
@@ -93,9 +94,15 @@ fn set(v: &mut [[f32; LEAF_WIDTH]; 3], k: usize, p: Vec3) {
     v[2][k] = p.z;
 }
 
+/// The rows of `v` in lanes, in the axis order `order` (an axis beyond z reads as NaN).
 #[inline(always)]
-fn lanes4(v: &[[f32; LEAF_WIDTH]; 3]) -> V3<f32x4> {
-    V3::new(f32x4::new(v[0]), f32x4::new(v[1]), f32x4::new(v[2]))
+fn lanes4(v: &[[f32; LEAF_WIDTH]; 3], order: [usize; 3]) -> V3<f32x4> {
+    // A function, not a closure: a closure may be left out of line (see crate::simd).
+    #[inline(always)]
+    fn row(v: &[[f32; LEAF_WIDTH]; 3], k: usize) -> f32x4 {
+        f32x4::new(v.get(k).copied().unwrap_or([f32::NAN; LEAF_WIDTH]))
+    }
+    V3::new(row(v, order[0]), row(v, order[1]), row(v, order[2]))
 }
 
 /// The box of points, NaN coordinates ignored (all NaN: the empty box).
@@ -168,17 +175,17 @@ impl Leaf for Tri4 {
     }
 
     #[inline(always)]
-    fn four(&self) -> TrianglePacket<f32x4> {
+    fn four(&self, order: [usize; 3]) -> TrianglePacket<f32x4> {
         TrianglePacket {
-            a: lanes4(&self.a),
-            b: lanes4(&self.b),
-            c: lanes4(&self.c),
+            a: lanes4(&self.a, order),
+            b: lanes4(&self.b, order),
+            c: lanes4(&self.c, order),
         }
     }
 
     #[inline(always)]
     fn boxes(&self) -> [f32x4; 6] {
-        triangle_boxes(&self.four())
+        triangle_boxes(&self.four(XYZ))
     }
 }
 
@@ -235,9 +242,9 @@ impl Leaf for Sphere4 {
     }
 
     #[inline(always)]
-    fn four(&self) -> SpherePacket<f32x4> {
+    fn four(&self, order: [usize; 3]) -> SpherePacket<f32x4> {
         SpherePacket {
-            center: lanes4(&self.center),
+            center: lanes4(&self.center, order),
             radius: f32x4::new(self.radius),
         }
     }
@@ -245,7 +252,7 @@ impl Leaf for Sphere4 {
     #[inline(always)]
     fn boxes(&self) -> [f32x4; 6] {
         // As `bounds` for every valid sphere (finite radius).
-        let (c, r) = (lanes4(&self.center), f32x4::new(self.radius));
+        let (c, r) = (lanes4(&self.center, XYZ), f32x4::new(self.radius));
         [c.x - r, c.y - r, c.z - r, c.x + r, c.y + r, c.z + r]
     }
 }

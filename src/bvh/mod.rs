@@ -589,11 +589,15 @@ impl<P: Leaf, N: Layout> Bvh<'_, P, N> {
                 let pre = pre.get_or_insert_with(|| K::prepare(&r4));
                 if C::EACH {
                     // Every root of the four (a filter may reject an entry root).
-                    return K::each(&r, pre, &leaf.four(), cull, |h| {
-                        offer_four(h, leaf, li, set, c)
-                    });
+                    return K::each_one(
+                        &r,
+                        pre,
+                        |order| leaf.four(order),
+                        cull,
+                        |h| offer_four(h, leaf, li, set, c),
+                    );
                 }
-                let Some(h) = K::first(&r, pre, &leaf.four(), cull) else {
+                let Some(h) = K::first_one(&r, pre, |order| leaf.four(order), cull) else {
                     return false;
                 };
                 offer_four(&h, leaf, li, set, c)

@@ -95,7 +95,7 @@ pub use watertight::{Shear, Watertight};
 use glam::Vec3;
 
 use crate::kernel::Cull;
-use crate::kernel::{Kernel, LaneHit, Primitive};
+use crate::kernel::{Kernel, LaneHit, Primitive, XYZ};
 use crate::lane::{Lane, Mask};
 use crate::ray::RayPacket;
 use crate::vec3::V3;
@@ -312,6 +312,17 @@ pub trait TriangleKernel {
         tri: &TrianglePacket<L>,
         cull: Cull,
     ) -> Option<LaneHit<L>>;
+    /// [`maybe_intersect`](Self::maybe_intersect) for one ray, the same in every lane, against
+    /// the triangles `load(order)` gives (see [`Kernel::first_one`]).
+    #[inline(always)]
+    fn maybe_intersect_one<L: Lane>(
+        ray: &RayPacket<L>,
+        pre: &Self::Rays<L>,
+        load: impl FnOnce([usize; 3]) -> TrianglePacket<L>,
+        cull: Cull,
+    ) -> Option<LaneHit<L>> {
+        Self::maybe_intersect(ray, pre, &load(XYZ), cull)
+    }
 }
 
 /// The steps shared by the deferred-division kernels, for lanes in `mask` whose edge tests
@@ -419,5 +430,27 @@ impl<K: TriangleKernel> Kernel<Triangle> for K {
         cull: Cull,
     ) -> Option<LaneHit<L>> {
         K::maybe_intersect(rays, pre, tri, cull)
+    }
+
+    #[inline(always)]
+    fn first_one<L: Lane>(
+        rays: &RayPacket<L>,
+        pre: &K::Rays<L>,
+        load: impl FnOnce([usize; 3]) -> TrianglePacket<L>,
+        cull: Cull,
+    ) -> Option<LaneHit<L>> {
+        K::maybe_intersect_one(rays, pre, load, cull)
+    }
+
+    #[inline(always)]
+    fn each_one<L: Lane>(
+        rays: &RayPacket<L>,
+        pre: &K::Rays<L>,
+        load: impl FnOnce([usize; 3]) -> TrianglePacket<L>,
+        cull: Cull,
+        mut f: impl FnMut(&LaneHit<L>) -> bool,
+    ) -> bool {
+        // As `each`'s default: a triangle has one hit.
+        Self::first_one(rays, pre, load, cull).is_some_and(|h| h.mask.any() && f(&h))
     }
 }

@@ -47,12 +47,15 @@ use crate::vec3::V3;
 pub struct Watertight;
 
 /// The per-ray constants of [`Watertight`]: the axis permutation (as lane masks: per permuted
-/// axis, "is x" and "is y", z otherwise), the permuted origin and the shear.
+/// axis, "is x" and "is y", z otherwise; and lane 0's as indices), the permuted origin and the
+/// shear.
 #[derive(Clone, Copy, Debug)]
 pub struct Shear<L: Lane> {
     kx: (L::Mask, L::Mask),
     ky: (L::Mask, L::Mask),
     kz: (L::Mask, L::Mask),
+    /// Lane 0's `kx`, `ky`, `kz`: every lane's for one ray in every lane.
+    order: [usize; 3],
     origin: V3<L>,
     sx: L,
     sy: L,
@@ -84,6 +87,7 @@ impl<L: Lane> Shear<L> {
             kx,
             ky,
             kz,
+            order: [axis::<L>(kx), axis::<L>(ky), axis::<L>(kz)],
             origin: ray.origin,
             sx: L::from_f32(0.0),
             sy: L::from_f32(0.0),
@@ -130,6 +134,18 @@ fn signs<L: Lane>(zero: L, u: L, v: L, w: L) -> ([L::Mask; 3], [L::Mask; 3]) {
     )
 }
 
+/// Lane 0's axis `k` (given as masks: "is x", "is y") as an index.
+#[inline(always)]
+fn axis<L: Lane>(k: (L::Mask, L::Mask)) -> usize {
+    if k.0.test(0) {
+        0
+    } else if k.1.test(0) {
+        1
+    } else {
+        2
+    }
+}
+
 /// `v[k]` per lane, for `k` given as masks ("is x", "is y").
 #[inline(always)]
 fn pick<L: Lane>(k: (L::Mask, L::Mask), v: V3<L>) -> L {
@@ -156,6 +172,19 @@ impl TriangleKernel for Watertight {
         let a = sh.permute(tri.a) - sh.origin;
         let b = sh.permute(tri.b) - sh.origin;
         let c = sh.permute(tri.c) - sh.origin;
+        sheared(ray, sh, a, b, c, cull)
+    }
+
+    /// One ray: the triangles loaded in the ray's axis order, so step 1 selects nothing.
+    #[inline(always)]
+    fn maybe_intersect_one<L: Lane>(
+        ray: &RayPacket<L>,
+        sh: &Shear<L>,
+        load: impl FnOnce([usize; 3]) -> TrianglePacket<L>,
+        cull: Cull,
+    ) -> Option<LaneHit<L>> {
+        let tri = load(sh.order);
+        let (a, b, c) = (tri.a - sh.origin, tri.b - sh.origin, tri.c - sh.origin);
         sheared(ray, sh, a, b, c, cull)
     }
 }
