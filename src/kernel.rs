@@ -147,20 +147,27 @@ pub trait Kernel<P: Primitive> {
         prim: &P::Packet<L>,
         cull: Cull,
     ) -> Option<LaneHit<L>>;
-    /// [`first`](Self::first) for one ray, the same in every lane of `rays`, against the
-    /// primitives `load(order)` gives, their coordinates in the axis order `order`: a kernel
-    /// whose per-ray constants permute the axes ([`Watertight`](crate::triangle::Watertight))
-    /// asks for its order, so that the primitives are loaded permuted once for all lanes
-    /// rather than selected lane by lane (the same values, so the same bits). By default
-    /// [`first`](Self::first) on `load(XYZ)`.
+    /// The axis order in which [`first_one`](Self::first_one) takes the primitives'
+    /// coordinates, for rays that all share lane 0's: a kernel whose per-ray constants permute
+    /// the axes ([`Watertight`](crate::triangle::Watertight)) asks for its permutation, so that
+    /// a leaf loads its primitives permuted once for all lanes rather than the kernel
+    /// selecting lane by lane. By default [`XYZ`].
+    #[inline(always)]
+    fn order<L: Lane>(_pre: &Self::Rays<L>) -> [usize; 3] {
+        XYZ
+    }
+    /// [`first`](Self::first) for one ray, the same in every lane of `rays`, against `prim`
+    /// with its coordinates in the order [`order(pre)`](Self::order): the same values as
+    /// [`first`](Self::first) on the primitives as they are, so the same bits. By default
+    /// [`first`](Self::first).
     #[inline(always)]
     fn first_one<L: Lane>(
         rays: &RayPacket<L>,
         pre: &Self::Rays<L>,
-        load: impl FnOnce([usize; 3]) -> P::Packet<L>,
+        prim: &P::Packet<L>,
         cull: Cull,
     ) -> Option<LaneHit<L>> {
-        Self::first(rays, pre, &load(XYZ), cull)
+        Self::first(rays, pre, prim, cull)
     }
     /// [`each`](Self::each) for one ray, as [`first_one`](Self::first_one) is
     /// [`first`](Self::first).
@@ -168,11 +175,11 @@ pub trait Kernel<P: Primitive> {
     fn each_one<L: Lane>(
         rays: &RayPacket<L>,
         pre: &Self::Rays<L>,
-        load: impl FnOnce([usize; 3]) -> P::Packet<L>,
+        prim: &P::Packet<L>,
         cull: Cull,
         f: impl FnMut(&LaneHit<L>) -> bool,
     ) -> bool {
-        Self::each(rays, pre, &load(XYZ), cull, f)
+        Self::each(rays, pre, prim, cull, f)
     }
     /// Every hit, in order along the rays (spheres: the entry roots, then, unless culled, the
     /// exit roots with `u = 1`), each passed to `f`; stops when `f` returns true, and returns
@@ -189,7 +196,7 @@ pub trait Kernel<P: Primitive> {
     }
 }
 
-/// The axis order x, y, z (see [`Kernel::first_one`]).
+/// The axis order x, y, z (see [`Kernel::order`]).
 pub const XYZ: [usize; 3] = [0, 1, 2];
 
 /// Whether a kernel can answer `ray`: for kernels that need unit directions, false when

@@ -37,7 +37,7 @@ pub trait Leaf: Packed {
     /// Lane `k`'s primitive in every lane (N rays × 1 primitive).
     fn splat<L: Lane>(&self, k: usize) -> <Self::Prim as Primitive>::Packet<L>;
     /// The leaf's primitives in `f32x4` lanes (1 ray × 4 primitives), their coordinates in
-    /// the axis order `order` (`XYZ`: x, y, z; what [`Kernel::first_one`] asks for).
+    /// the axis order `order` (`XYZ`: x, y, z; what [`Kernel::order`] asks for).
     fn four(&self, order: [usize; 3]) -> <Self::Prim as Primitive>::Packet<f32x4>;
     /// The boxes of the lanes' primitives that can be hit, as [`Packed::bounds`] gives them
     /// (rows minimum x, y, z, maximum x, y, z; a primitive per lane), for a packet's cull.

@@ -586,18 +586,16 @@ impl<P: Leaf, N: Layout> Bvh<'_, P, N> {
                 } else {
                     r4
                 };
-                let pre = pre.get_or_insert_with(|| K::prepare(&r4));
+                let (pre, order) = pre.get_or_insert_with(|| {
+                    let pre = K::prepare(&r4);
+                    (pre, K::order(&pre))
+                });
+                let four = leaf.four(*order);
                 if C::EACH {
                     // Every root of the four (a filter may reject an entry root).
-                    return K::each_one(
-                        &r,
-                        pre,
-                        |order| leaf.four(order),
-                        cull,
-                        |h| offer_four(h, leaf, li, set, c),
-                    );
+                    return K::each_one(&r, pre, &four, cull, |h| offer_four(h, leaf, li, set, c));
                 }
-                let Some(h) = K::first_one(&r, pre, |order| leaf.four(order), cull) else {
+                let Some(h) = K::first_one(&r, pre, &four, cull) else {
                     return false;
                 };
                 offer_four(&h, leaf, li, set, c)

@@ -312,16 +312,22 @@ pub trait TriangleKernel {
         tri: &TrianglePacket<L>,
         cull: Cull,
     ) -> Option<LaneHit<L>>;
+    /// The axis order of [`Kernel::order`]: by default [`XYZ`].
+    #[inline(always)]
+    fn order<L: Lane>(_pre: &Self::Rays<L>) -> [usize; 3] {
+        XYZ
+    }
     /// [`maybe_intersect`](Self::maybe_intersect) for one ray, the same in every lane, against
-    /// the triangles `load(order)` gives (see [`Kernel::first_one`]).
+    /// `tri` with its coordinates in the order [`order(pre)`](Self::order) (see
+    /// [`Kernel::first_one`]).
     #[inline(always)]
     fn maybe_intersect_one<L: Lane>(
         ray: &RayPacket<L>,
         pre: &Self::Rays<L>,
-        load: impl FnOnce([usize; 3]) -> TrianglePacket<L>,
+        tri: &TrianglePacket<L>,
         cull: Cull,
     ) -> Option<LaneHit<L>> {
-        Self::maybe_intersect(ray, pre, &load(XYZ), cull)
+        Self::maybe_intersect(ray, pre, tri, cull)
     }
 }
 
@@ -433,24 +439,29 @@ impl<K: TriangleKernel> Kernel<Triangle> for K {
     }
 
     #[inline(always)]
+    fn order<L: Lane>(pre: &K::Rays<L>) -> [usize; 3] {
+        K::order(pre)
+    }
+
+    #[inline(always)]
     fn first_one<L: Lane>(
         rays: &RayPacket<L>,
         pre: &K::Rays<L>,
-        load: impl FnOnce([usize; 3]) -> TrianglePacket<L>,
+        tri: &TrianglePacket<L>,
         cull: Cull,
     ) -> Option<LaneHit<L>> {
-        K::maybe_intersect_one(rays, pre, load, cull)
+        K::maybe_intersect_one(rays, pre, tri, cull)
     }
 
     #[inline(always)]
     fn each_one<L: Lane>(
         rays: &RayPacket<L>,
         pre: &K::Rays<L>,
-        load: impl FnOnce([usize; 3]) -> TrianglePacket<L>,
+        tri: &TrianglePacket<L>,
         cull: Cull,
         mut f: impl FnMut(&LaneHit<L>) -> bool,
     ) -> bool {
         // As `each`'s default: a triangle has one hit.
-        Self::first_one(rays, pre, load, cull).is_some_and(|h| h.mask.any() && f(&h))
+        Self::first_one(rays, pre, tri, cull).is_some_and(|h| h.mask.any() && f(&h))
     }
 }

@@ -47,15 +47,12 @@ use crate::vec3::V3;
 pub struct Watertight;
 
 /// The per-ray constants of [`Watertight`]: the axis permutation (as lane masks: per permuted
-/// axis, "is x" and "is y", z otherwise; and lane 0's as indices), the permuted origin and the
-/// shear.
+/// axis, "is x" and "is y", z otherwise), the permuted origin and the shear.
 #[derive(Clone, Copy, Debug)]
 pub struct Shear<L: Lane> {
     kx: (L::Mask, L::Mask),
     ky: (L::Mask, L::Mask),
     kz: (L::Mask, L::Mask),
-    /// Lane 0's `kx`, `ky`, `kz`: every lane's for one ray in every lane.
-    order: [usize; 3],
     origin: V3<L>,
     sx: L,
     sy: L,
@@ -87,7 +84,6 @@ impl<L: Lane> Shear<L> {
             kx,
             ky,
             kz,
-            order: [axis::<L>(kx), axis::<L>(ky), axis::<L>(kz)],
             origin: ray.origin,
             sx: L::from_f32(0.0),
             sy: L::from_f32(0.0),
@@ -175,15 +171,20 @@ impl TriangleKernel for Watertight {
         sheared(ray, sh, a, b, c, cull)
     }
 
-    /// One ray: the triangles loaded in the ray's axis order, so step 1 selects nothing.
+    /// Lane 0's `kx`, `ky`, `kz`.
+    #[inline(always)]
+    fn order<L: Lane>(sh: &Shear<L>) -> [usize; 3] {
+        [axis::<L>(sh.kx), axis::<L>(sh.ky), axis::<L>(sh.kz)]
+    }
+
+    /// One ray, the triangles given in its axis order: step 1 selects nothing.
     #[inline(always)]
     fn maybe_intersect_one<L: Lane>(
         ray: &RayPacket<L>,
         sh: &Shear<L>,
-        load: impl FnOnce([usize; 3]) -> TrianglePacket<L>,
+        tri: &TrianglePacket<L>,
         cull: Cull,
     ) -> Option<LaneHit<L>> {
-        let tri = load(sh.order);
         let (a, b, c) = (tri.a - sh.origin, tri.b - sh.origin, tri.c - sh.origin);
         sheared(ray, sh, a, b, c, cull)
     }
