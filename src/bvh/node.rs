@@ -480,20 +480,24 @@ impl Slab {
         } else {
             (zero, zero)
         };
-        let bits = neg.bits();
-        let three = |v: f32x4| {
+        // Functions and plain values, not closures: a closure may be left out of line (see
+        // crate::simd).
+        #[inline(always)]
+        fn xyz(v: f32x4) -> [f32; 3] {
             let v = v.to_array();
             [v[0], v[1], v[2]]
-        };
-        let k = |a: usize| (bits >> a & 1) as usize;
+        }
+        let bits = neg.bits();
+        let (kx, ky, kz) = (bits & 1, bits >> 1 & 1, bits >> 2 & 1);
+        let (kx, ky, kz) = (kx as usize, ky as usize, kz as usize);
         Slab {
-            near: [3 * k(0), 1 + 3 * k(1), 2 + 3 * k(2)],
-            far: [3 - 3 * k(0), 4 - 3 * k(1), 5 - 3 * k(2)],
-            on: three(on),
-            of: three(of),
-            inv: three(inv),
-            qn: three(qn),
-            qf: three(qf),
+            near: [3 * kx, 1 + 3 * ky, 2 + 3 * kz],
+            far: [3 - 3 * kx, 4 - 3 * ky, 5 - 3 * kz],
+            on: xyz(on),
+            of: xyz(of),
+            inv: xyz(inv),
+            qn: xyz(qn),
+            qf: xyz(qf),
             all,
         }
     }
