@@ -780,7 +780,7 @@ mod alloc_only {
         let need = sizes(n);
         let mut nodes = vec![Node::EMPTY; n / 3 + 2];
         let mut scratch = vec![Scratch::default(); need.scratch];
-        let (used, l) = topology(&tris[..], &mut nodes, &mut scratch, 4, true)
+        let (used, l) = topology(&tris[..], &mut nodes, &mut scratch, 4, LEAF_WIDTH, true)
             .map_err(|_| BakeError::TooMany)?;
         let mut leaves = vec![Tri4::EMPTY; l];
         fill(&tris[..], &scratch[..n], &mut leaves);

@@ -143,7 +143,7 @@ struct Part {
 /// One pass bins the centroids on all three axes at once (16 bins each: count and box); a
 /// sweep per axis gives every plane's `A_L·N_L + A_R·N_R`; the children's boxes are unions
 /// of the chosen axis's bins, and the partition pass gathers their centroid boxes.
-fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, Boxes, Boxes)> {
+fn sah_split(s: &mut [Scratch], cb: &Box3, leaf: usize) -> Option<(usize, Boxes, Boxes)> {
     let (cmin, cmax) = *cb;
     let mut k = [0.0f32; 3];
     let mut any = false;
@@ -218,7 +218,8 @@ fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, Boxes, Boxes)> {
             union(&mut acc, &boxes[i]);
             n += count[i];
             // Primitives count in whole leaves (Embree's blocks): a side of 5 costs as 8.
-            let cost = lanes_area(&acc) * blocks(n) + right_area[j] * blocks(right_count[j]);
+            let cost =
+                lanes_area(&acc) * blocks(n, leaf) + right_area[j] * blocks(right_count[j], leaf);
             if best.is_none_or(|b| cost < b.0) {
                 best = Some((cost, axis, i));
             }
@@ -261,25 +262,25 @@ fn sah_split(s: &mut [Scratch], cb: &Box3) -> Option<(usize, Boxes, Boxes)> {
     Some((i, (lb, lc), (rb, rc)))
 }
 
-/// `n` primitives as the leaves they fill: `⌈n / LEAF_WIDTH⌉`.
+/// `n` primitives as the leaves of up to `leaf` they fill: `⌈n / leaf⌉`.
 #[inline(always)]
-fn blocks(n: u32) -> f32 {
-    n.div_ceil(LEAF_WIDTH as u32) as f32
+fn blocks(n: u32, leaf: usize) -> f32 {
+    n.div_ceil(leaf as u32) as f32
 }
 
-/// Splits `s` (more than [`LEAF_WIDTH`] primitives, centroid box `cb`) into two non-empty
-/// parts; returns the size of the first and both parts' boxes and centroid boxes. Binned SAH
-/// above [`SAH_DEPTH`], the middle index (rounded up to a multiple of [`LEAF_WIDTH`]) below it
-/// or when SAH finds no plane.
-fn split(s: &mut [Scratch], cb: &Box3, depth: u32) -> (usize, Boxes, Boxes) {
+/// Splits `s` (more than `leaf` primitives, centroid box `cb`) into two non-empty parts;
+/// returns the size of the first and both parts' boxes and centroid boxes. Binned SAH above
+/// [`SAH_DEPTH`], the middle index (rounded up to a multiple of `leaf`) below it or when SAH
+/// finds no plane.
+fn split(s: &mut [Scratch], cb: &Box3, depth: u32, leaf: usize) -> (usize, Boxes, Boxes) {
     if depth < SAH_DEPTH
-        && let Some(r) = sah_split(s, cb)
+        && let Some(r) = sah_split(s, cb, leaf)
     {
         return r;
     }
     // The middle, rounded up to whole leaves where that leaves both sides non-empty.
     let half = s.len() / 2;
-    let whole = half.div_ceil(LEAF_WIDTH) * LEAF_WIDTH;
+    let whole = half.div_ceil(leaf) * leaf;
     let mid = if whole < s.len() { whole } else { half };
     (mid, range_boxes(&s[..mid]), range_boxes(&s[mid..]))
 }
@@ -314,7 +315,7 @@ pub(crate) fn build<'s, P: Primitives + ?Sized>(
     leaves: &'s mut [P::Leaf],
     scratch: &mut [Scratch],
 ) -> Result<Bvh<'s, P::Leaf>, BuildError> {
-    let (used_nodes, used_leaves) = topology(prims, nodes, scratch, WIDTH, false)?;
+    let (used_nodes, used_leaves) = topology(prims, nodes, scratch, WIDTH, LEAF_WIDTH, false)?;
     if leaves.len() < used_leaves {
         return Err(BuildError::Leaves(TooSmall {
             needed: used_leaves,
@@ -334,23 +335,29 @@ pub(crate) fn build<'s, P: Primitives + ?Sized>(
 /// first entry of each leaf marked with the leaf's number and size (see [`fill`]). Returns the
 /// numbers of nodes and leaves used, so that the leaves can be stored in exactly as many
 /// slots. At most `width` (2 to [`WIDTH`]) children per node, the others empty (4: the base
-/// of the layout a bake converts).
+/// of the layout a bake converts), and at most `per_leaf` primitives per leaf ([`LEAF_WIDTH`];
+/// or 1: every primitive a child of its node, referred to by its own index, `LEAF | i`, so
+/// that there are no leaves to fill: an owned scene's top level, see [`refit_direct`]).
 pub(crate) fn topology<P: Primitives + ?Sized>(
     prims: &P,
     nodes: &mut [Node],
     scratch: &mut [Scratch],
     width: usize,
+    per_leaf: usize,
     threads: bool,
 ) -> Result<(usize, usize), BuildError> {
     let width = width.clamp(2, WIDTH);
+    let per_leaf = per_leaf.clamp(1, LEAF_WIDTH);
     let n = prims.count();
     if n > MAX_PRIMITIVES {
         return Err(BuildError::TooMany);
     }
     let need = sizes(n);
     let short = |needed| TooSmall { needed };
-    if nodes.len() < need.nodes {
-        return Err(BuildError::Nodes(short(need.nodes)));
+    // With one primitive per leaf, every inner node but a lone root has two children or more.
+    let need_nodes = if per_leaf == 1 { n.max(1) } else { need.nodes };
+    if nodes.len() < need_nodes {
+        return Err(BuildError::Nodes(short(need_nodes)));
     }
     if scratch.len() < need.scratch {
         return Err(BuildError::Scratch(short(need.scratch)));
@@ -379,12 +386,13 @@ pub(crate) fn topology<P: Primitives + ?Sized>(
     nodes[0] = job([0, n as u32, 1, NONE], &b, &cb);
     // Below this many primitives threads did not pay on 2 cores (the scenes benchmark:
     // 58,784 triangles 0.93× one thread, 69,451 1.13×).
+    // (Threads renumber the leaves, which a direct tree does not have.)
     #[cfg(feature = "std")]
-    if threads && n >= 1 << 16 {
+    if threads && per_leaf == LEAF_WIDTH && n >= 1 << 16 {
         return threaded(nodes, s, width);
     }
     let _ = threads;
-    let g = expand(nodes, s, width, Grown::ROOT, usize::MAX)?;
+    let g = expand(nodes, s, width, per_leaf, Grown::ROOT, usize::MAX)?;
     Ok((g.nodes, g.leaves))
 }
 
@@ -403,7 +411,7 @@ fn threaded(
     use std::sync::Mutex;
     use std::vec::Vec;
 
-    let root = expand(nodes, s, width, Grown::ROOT, 1)?;
+    let root = expand(nodes, s, width, LEAF_WIDTH, Grown::ROOT, 1)?;
     // The root's inner children, in the order the one-thread build takes them.
     let mut kids = Vec::new();
     let mut t = root.top;
@@ -414,7 +422,7 @@ fn threaded(
     }
     let cores = std::thread::available_parallelism().map_or(1, |c| c.get());
     if cores < 2 || kids.len() < 2 {
-        let g = expand(nodes, s, width, root, usize::MAX)?;
+        let g = expand(nodes, s, width, LEAF_WIDTH, root, usize::MAX)?;
         return Ok((g.nodes, g.leaves));
     }
     // Each child's part of the scratch (disjoint ranges), the largest first.
@@ -444,7 +452,8 @@ fn threaded(
                         let Some((i, part)) = next else { break };
                         let mut local = std::vec![Node::EMPTY; sizes(part.len()).nodes];
                         local[0] = kids[i].3;
-                        let g = expand(&mut local, part, width, Grown::ROOT, usize::MAX);
+                        let g =
+                            expand(&mut local, part, width, LEAF_WIDTH, Grown::ROOT, usize::MAX);
                         out.push((
                             i,
                             g.map(|g| {
@@ -532,6 +541,7 @@ pub(crate) fn expand(
     nodes: &mut [Node],
     s: &mut [Scratch],
     width: usize,
+    per_leaf: usize,
     from: Grown,
     limit: usize,
 ) -> Result<Grown, BuildError> {
@@ -546,6 +556,21 @@ pub(crate) fn expand(
         let node = top as usize;
         let ([start, end, depth, next], b, cb) = unjob(&nodes[node]);
         top = next;
+        if per_leaf == 1 && (end - start) as usize <= width {
+            // Every primitive a child: where the splits below would end, without them.
+            let mut out = Node::EMPTY;
+            for (k, p) in s[start as usize..end as usize].iter().enumerate() {
+                let (lo, hi) = unlanes(&p.b);
+                for axis in 0..3 {
+                    out.bounds[axis][k] = lo[axis];
+                    out.bounds[3 + axis][k] = hi[axis];
+                }
+                out.child[k] = LEAF | p.index;
+                used_leaves += 1;
+            }
+            nodes[node] = out;
+            continue;
+        }
         // Children as ranges; split the one of largest area until WIDTH or all are leaves.
         let mut kids = [Part { start, end, b, cb }; WIDTH];
         let mut nk = 1;
@@ -558,7 +583,7 @@ pub(crate) fn expand(
             let mut best_count = 0;
             for (k, kid) in kids[..nk].iter().enumerate() {
                 let count = (kid.end - kid.start) as usize;
-                if count <= LEAF_WIDTH {
+                if count <= per_leaf {
                     continue;
                 }
                 let a = if depth < SAH_DEPTH {
@@ -579,7 +604,8 @@ pub(crate) fn expand(
                 cb,
                 ..
             } = kids[k];
-            let (mid, (lb, lcb), (rb, rcb)) = split(&mut s[a as usize..b as usize], &cb, depth);
+            let (mid, (lb, lcb), (rb, rcb)) =
+                split(&mut s[a as usize..b as usize], &cb, depth, per_leaf);
             let mid = a + mid as u32;
             kids.copy_within(k + 1..nk, k + 2);
             kids[k] = Part {
@@ -604,7 +630,10 @@ pub(crate) fn expand(
                 out.bounds[axis][k] = lo[axis];
                 out.bounds[3 + axis][k] = hi[axis];
             }
-            if (b - a) as usize <= LEAF_WIDTH {
+            if per_leaf == 1 && b - a == 1 {
+                out.child[k] = LEAF | s[a as usize].index;
+                used_leaves += 1;
+            } else if (b - a) as usize <= per_leaf {
                 mark(&mut s[a as usize], used_leaves as u32, b - a);
                 out.child[k] = LEAF | used_leaves as u32;
                 used_leaves += 1;
@@ -693,6 +722,54 @@ pub(crate) fn refit<'s, P: Primitives + ?Sized>(
             prims.put(i, leaf, lane);
         }
     }
+    refit_nodes(nodes, |l, b| {
+        let leaf = leaves.get(l as usize).ok_or(BuildError::Mismatch)?;
+        for lane in 0..LEAF_WIDTH {
+            if leaf.indices()[lane] != EMPTY {
+                let (lo, hi) = leaf.bounds(lane);
+                grow(b, &lo, &hi);
+            }
+        }
+        Ok(())
+    })?;
+    let nodes: &'s [Node] = nodes;
+    let leaves: &'s [P::Leaf] = leaves;
+    Ok(Bvh {
+        nodes,
+        leaves,
+        reach: reach(&nodes[0]),
+    })
+}
+
+/// [`refit`] for a tree whose leaves are its primitives (built with one primitive per leaf,
+/// see [`topology`]): every box recomputed from `prims`, children before parents; returns the
+/// root's reach. [`BuildError::Mismatch`] for an empty `nodes`, a primitive index past
+/// `prims` or a child index out of range.
+pub(crate) fn refit_direct<P: Primitives + ?Sized>(
+    prims: &P,
+    nodes: &mut [Node],
+) -> Result<f32, BuildError> {
+    let n = prims.count();
+    refit_nodes(nodes, |i, b| {
+        if i as usize >= n {
+            return Err(BuildError::Mismatch);
+        }
+        let (lo, hi) = prims.bounds(i);
+        grow(b, &lo, &hi);
+        Ok(())
+    })?;
+    nodes.first().map(reach).ok_or(BuildError::Mismatch)
+}
+
+/// Recomputes every node's boxes, children before parents: a leaf child `LEAF | l` from
+/// `leaf(l, box)`, which grows the box by the leaf's primitives.
+fn refit_nodes(
+    nodes: &mut [Node],
+    mut leaf: impl FnMut(u32, &mut Box3) -> Result<(), BuildError>,
+) -> Result<(), BuildError> {
+    if nodes.is_empty() {
+        return Err(BuildError::Mismatch);
+    }
     for i in (0..nodes.len()).rev() {
         let mut out = nodes[i];
         for k in 0..WIDTH {
@@ -700,15 +777,7 @@ pub(crate) fn refit<'s, P: Primitives + ?Sized>(
             let mut b = EMPTY_BOX;
             if c == EMPTY {
             } else if c & LEAF != 0 {
-                let leaf = leaves
-                    .get((c & !LEAF) as usize)
-                    .ok_or(BuildError::Mismatch)?;
-                for lane in 0..LEAF_WIDTH {
-                    if leaf.indices()[lane] != EMPTY {
-                        let (lo, hi) = leaf.bounds(lane);
-                        grow(&mut b, &lo, &hi);
-                    }
-                }
+                leaf(c & !LEAF, &mut b)?;
             } else {
                 if c as usize <= i {
                     return Err(BuildError::Mismatch);
@@ -729,13 +798,7 @@ pub(crate) fn refit<'s, P: Primitives + ?Sized>(
         }
         nodes[i] = out;
     }
-    let nodes: &'s [Node] = nodes;
-    let leaves: &'s [P::Leaf] = leaves;
-    Ok(Bvh {
-        nodes,
-        leaves,
-        reach: reach(&nodes[0]),
-    })
+    Ok(())
 }
 
 #[cfg(test)]

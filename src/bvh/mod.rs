@@ -377,63 +377,81 @@ impl<'s, P: Packed, N: Layout> Bvh<'s, P, N> {
     /// The box of the root (the union of its children's boxes).
     #[must_use]
     pub fn root_box(&self) -> ([f32; 3], [f32; 3]) {
-        let mut lo = [f32::INFINITY; 3];
-        let mut hi = [f32::NEG_INFINITY; 3];
-        if let Some(n) = self.nodes.first() {
-            for k in 0..WIDTH {
-                if n.child(k) == EMPTY {
-                    continue;
-                }
-                let (l, h) = n.bounds(k);
-                for a in 0..3 {
-                    lo[a] = min(lo[a], l[a]);
-                    hi[a] = max(hi[a], h[a]);
-                }
-            }
-        }
-        (lo, hi)
+        root_box(self.nodes)
     }
 
     /// Depth, node and leaf counts and SAH cost of the tree (walks every node).
     #[must_use]
     pub fn stats(&self) -> Stats {
-        let (lo, hi) = self.root_box();
-        let root_area = area(lo, hi) as f64;
-        let mut sah = 1.0f64; // the root's traversal
-        let mut prims = 0usize;
-        for n in self.nodes {
-            for k in 0..WIDTH {
-                let c = n.child(k);
-                if c == EMPTY {
-                    continue;
-                }
-                let (lo, hi) = n.bounds(k);
-                let rel = if root_area > 0.0 {
-                    area(lo, hi) as f64 / root_area
-                } else {
-                    1.0
-                };
-                if c & LEAF != 0 {
-                    let count = self
-                        .leaves
-                        .get((c & !LEAF) as usize)
-                        .map_or(0, |l| l.indices().iter().filter(|&&i| i != EMPTY).count());
-                    prims += count;
-                    sah += rel * count as f64;
-                } else {
-                    sah += rel;
-                }
+        let held = |l: u32| {
+            self.leaves
+                .get(l as usize)
+                .map_or(0, |l| l.indices().iter().filter(|&&i| i != EMPTY).count())
+        };
+        let bytes = core::mem::size_of_val(self.nodes) + core::mem::size_of_val(self.leaves);
+        stats(self.nodes, held, self.leaves.len(), bytes)
+    }
+}
+
+/// The box of the root of `nodes` (the union of its children's boxes).
+pub(crate) fn root_box<N: Layout>(nodes: &[N]) -> ([f32; 3], [f32; 3]) {
+    let mut lo = [f32::INFINITY; 3];
+    let mut hi = [f32::NEG_INFINITY; 3];
+    if let Some(n) = nodes.first() {
+        for k in 0..WIDTH {
+            if n.child(k) == EMPTY {
+                continue;
+            }
+            let (l, h) = n.bounds(k);
+            for a in 0..3 {
+                lo[a] = min(lo[a], l[a]);
+                hi[a] = max(hi[a], h[a]);
             }
         }
-        let max_depth = depth(self.nodes).unwrap_or(0);
-        Stats {
-            nodes: self.nodes.len(),
-            leaves: self.leaves.len(),
-            primitives: prims,
-            depth: max_depth,
-            sah,
-            bytes: core::mem::size_of_val(self.nodes) + core::mem::size_of_val(self.leaves),
+    }
+    (lo, hi)
+}
+
+/// [`Bvh::stats`] of the tree `nodes` whose leaf child `LEAF | l` holds `held(l)` primitives
+/// (`leaves` leaves and `bytes` bytes in all).
+pub(crate) fn stats<N: Layout>(
+    nodes: &[N],
+    held: impl Fn(u32) -> usize,
+    leaves: usize,
+    bytes: usize,
+) -> Stats {
+    let (lo, hi) = root_box(nodes);
+    let root_area = area(lo, hi) as f64;
+    let mut sah = 1.0f64; // the root's traversal
+    let mut prims = 0usize;
+    for n in nodes {
+        for k in 0..WIDTH {
+            let c = n.child(k);
+            if c == EMPTY {
+                continue;
+            }
+            let (lo, hi) = n.bounds(k);
+            let rel = if root_area > 0.0 {
+                area(lo, hi) as f64 / root_area
+            } else {
+                1.0
+            };
+            if c & LEAF != 0 {
+                let count = held(c & !LEAF);
+                prims += count;
+                sah += rel * count as f64;
+            } else {
+                sah += rel;
+            }
         }
+    }
+    Stats {
+        nodes: nodes.len(),
+        leaves,
+        primitives: prims,
+        depth: depth(nodes).unwrap_or(0),
+        sah,
+        bytes,
     }
 }
 
@@ -875,7 +893,7 @@ impl<P: Packed> OwnedBvh<P> {
         let mut nodes = vec![Node::EMPTY; need.nodes];
         let mut scratch = vec![Scratch::default(); need.scratch];
         // The leaves are allocated once the first pass has counted them (about n/4).
-        let (n, l) = build::topology(prims, &mut nodes, &mut scratch, WIDTH, true)?;
+        let (n, l) = build::topology(prims, &mut nodes, &mut scratch, WIDTH, LEAF_WIDTH, true)?;
         let mut leaves = vec![P::EMPTY; l];
         build::fill(prims, &scratch[..prims.count()], &mut leaves);
         drop(scratch);

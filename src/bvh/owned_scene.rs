@@ -57,12 +57,14 @@
 //! world boxes) and then refits or rebuilds the top level, never an object:
 //!
 //! * **Rebuild** (binned SAH over the instances' world boxes, as the caller-storage
-//!   [`Scene`](super::Scene) is built) when the number of slots changed (an `add` past the
-//!   free slots), or when the refitted tree's SAH cost exceeds [`REBUILD_RATIO`] times the cost
-//!   it had when it was last built;
-//! * **Refit** (every box recomputed, the topology kept: [`Bvh::refit`](super::Bvh::refit))
-//!   otherwise — also after removals and after adds into freed slots (a free slot is an
-//!   instance with an empty box).
+//!   [`Scene`](super::Scene) is built, but with every instance a child of its node: the tree
+//!   has no leaves of instance boxes, so a node's test is the test of its instances' own
+//!   boxes and an instance it enters is read at once) when the number of slots changed (an
+//!   `add` past the free slots), or when the refitted tree's SAH cost exceeds
+//!   [`REBUILD_RATIO`] times the cost it had when it was last built;
+//! * **Refit** (every box recomputed from the world boxes, the topology kept) otherwise — also
+//!   after removals and after adds into freed slots (a free slot is an instance with an empty
+//!   box).
 //!
 //! The rule was chosen by measurement (`examples/game`, 10,000 instances moving every frame):
 //! see [`REBUILD_RATIO`]; an engine may set its own ([`OwnedScene::set_rebuild_ratio`]).
@@ -87,10 +89,11 @@
 use alloc::vec::Vec;
 use core::marker::PhantomData;
 
-use super::scene::{
-    instance_records, instances, instances_one, object_packet, object_ray, world_record,
+use super::scene::{instance_records, object_packet, object_ray, world_record};
+use super::{
+    Inst4, Instance, Node, OwnedBvh, Primitives, Scratch, Sphere4, Stats, Tri4, WIDTH, build,
+    reach, split, stats, traverse,
 };
-use super::{Inst4, Instance, OwnedBvh, Primitives, Sphere4, Stats, Tri4, build, split};
 use crate::hit::{Candidate, Collector, Hit, Hits, Winners, alone};
 use crate::kernel::{Cull, Kernel};
 use crate::lane::{Lane, Mask};
@@ -104,15 +107,17 @@ use crate::triangle::{Triangle, Watertight};
 ///
 /// Measured with `examples/game` (10,000 instances of 7 objects, all moving every frame; one
 /// thread; `--speed 3`: frames of 1/20 s): a rebuild costs 3–4 ms against a refit's 0.4–0.6
-/// ms, and the frame's queries (about 10 ms: a pick, 1,000 sight lines, 10,000 bullets, a
+/// ms (3.7–5 ms and 0.45–0.6 ms since the instances are the nodes' children), and the frame's
+/// queries (about 10 ms: a pick, 1,000 sight lines, 10,000 bullets, a
 /// shadow ray per impact) cost about half the SAH ratio's excess more on a refitted tree
 /// (ratio 1.08: +1.5 %; 1.21: +12 %; 1.57: +21 %; 2.4: +98 %). Rebuilding every `N` frames
 /// while the loss grows by `g` per frame costs `R/N + g·N/2` per frame on average, least when
 /// the loss at the rebuild is `√(2·R·g)`: about 0.3–0.45 ms here, a ratio of 1.08–1.1. Over
 /// 200 frames (two runs) the mean frame took 11.9 and 12.8 ms at 1.1 (6 rebuilds), 12.8 and
 /// 11.9 at 1.2 (4), 12.7 and 13.1 at 1.05 (8), 14.1 and 13.3 at 1.5 (2), 18.5 and 16.3
-/// refitting only, 19.1 and 15.5 rebuilding every frame. See `docs/design.md`, "An engine's
-/// scene".
+/// refitting only, 19.1 and 15.5 rebuilding every frame; with the instances as the nodes'
+/// children, 10.6 and 10.6 at 1.05 (6 rebuilds), 10.7 and 10.6 at 1.1 (4), 11.0 and 11.0 at
+/// 1.2 (3). See `docs/design.md`, "An engine's scene".
 pub const REBUILD_RATIO: f64 = 1.1;
 
 /// An object of an [`OwnedScene`]: a BVH over a triangle mesh or over spheres, built once and
@@ -306,7 +311,7 @@ pub struct OwnedScene {
     /// The committed slots' generations.
     generations: Vec<u32>,
     boxes: Vec<([f32; 3], [f32; 3])>,
-    top: OwnedBvh<Inst4>,
+    top: Top,
     /// The top level's SAH cost when it was last built.
     built_sah: f64,
     /// [`REBUILD_RATIO`] or the engine's own ([`set_rebuild_ratio`](Self::set_rebuild_ratio)).
@@ -323,7 +328,7 @@ impl OwnedScene {
     /// An empty scene (every query misses).
     #[must_use]
     pub fn new() -> Self {
-        let top = empty_top();
+        let top = Top::build(&Boxes(&[]));
         OwnedScene {
             objects: Vec::new(),
             object_boxes: Vec::new(),
@@ -514,7 +519,7 @@ impl OwnedScene {
     /// The top level's size, depth and SAH cost (see [`Stats`]).
     #[must_use]
     pub fn stats(&self) -> Stats {
-        self.top.view().stats()
+        self.top.stats()
     }
 
     /// This scene seen by queries on the layers `mask` ([`Filtered::mask`]; per lane:
@@ -609,21 +614,15 @@ impl OwnedScene {
             };
         }
         let prims = Boxes(&self.boxes);
-        if !rebuild && !grown {
-            let OwnedBvh {
-                nodes,
-                leaves,
-                reach,
-            } = &mut self.top;
-            if let Ok(tree) = build::refit(&prims, nodes, leaves) {
-                *reach = tree.reach;
-                if self.top.view().stats().sah <= self.ratio * self.built_sah {
-                    return Commit::Refit;
-                }
-            }
+        if !rebuild
+            && !grown
+            && self.top.refit(&prims)
+            && self.top.stats().sah <= self.ratio * self.built_sah
+        {
+            return Commit::Refit;
         }
-        self.top = OwnedBvh::new(&prims).unwrap_or_else(|_| empty_top());
-        self.built_sah = self.top.view().stats().sah;
+        self.top = Top::build(&prims);
+        self.built_sah = self.top.stats().sah;
         Commit::Rebuild
     }
 
@@ -648,11 +647,12 @@ impl OwnedScene {
         set: u32,
         c: &mut C,
     ) -> bool {
-        instances(
-            &self.top.view(),
+        traverse::many(
+            &self.top.nodes,
+            self.top.reach,
             rays,
             c,
-            |i, r, c| {
+            |i, r, _, c| {
                 let Some((p, object)) = self.placed(i) else {
                     return false;
                 };
@@ -704,7 +704,7 @@ impl OwnedScene {
         set: u32,
         c: &mut C,
     ) -> bool {
-        instances_one(&self.top.view(), ray, start, c, |i, c| {
+        traverse::one(&self.top.nodes, self.top.reach, ray, start, c, |i, c| {
             let Some((p, object)) = self.placed(i) else {
                 return false;
             };
@@ -736,13 +736,56 @@ impl OwnedScene {
     }
 }
 
-/// A top level over no instance.
-fn empty_top() -> OwnedBvh<Inst4> {
-    OwnedBvh::new(&Boxes(&[])).unwrap_or(OwnedBvh {
-        nodes: Vec::new(),
-        leaves: Vec::new(),
-        reach: 0.0,
-    })
+/// The top level: a tree whose leaves are the committed slots themselves, each a child of its
+/// node (`LEAF | slot`), so that a node's test is the test of its instances' world boxes and
+/// entering an instance reads its entry straight away (no leaf of instance boxes between).
+#[derive(Clone, Debug)]
+struct Top {
+    nodes: Vec<Node>,
+    /// The largest coordinate of the root's children (the slab test's margin).
+    reach: f32,
+}
+
+impl Top {
+    /// The binned SAH build over `prims`, one slot per leaf (an empty root when there is none).
+    fn build(prims: &Boxes) -> Top {
+        let n = prims.count();
+        let mut nodes = alloc::vec![Node::EMPTY; n.max(1)];
+        let mut scratch = alloc::vec![Scratch::default(); n];
+        match build::topology(prims, &mut nodes, &mut scratch, WIDTH, 1, false) {
+            Ok((used, _)) => nodes.truncate(used.max(1)),
+            Err(_) => nodes = alloc::vec![Node::EMPTY],
+        }
+        nodes.shrink_to_fit();
+        let reach = nodes.first().map_or(0.0, reach);
+        Top { nodes, reach }
+    }
+
+    /// Every box recomputed from `prims` (the same slots), the topology kept; false when it
+    /// does not fit them (then the caller rebuilds).
+    fn refit(&mut self, prims: &Boxes) -> bool {
+        match build::refit_direct(prims, &mut self.nodes) {
+            Ok(reach) => {
+                self.reach = reach;
+                true
+            }
+            Err(_) => false,
+        }
+    }
+
+    /// Size, depth and SAH cost (a slot counts as a leaf of one primitive).
+    fn stats(&self) -> Stats {
+        let s = stats(
+            &self.nodes,
+            |_| 1,
+            0,
+            core::mem::size_of_val(&self.nodes[..]),
+        );
+        Stats {
+            leaves: s.primitives,
+            ..s
+        }
+    }
 }
 
 /// An owned scene answers like the caller-storage [`Scene`](super::Scene) over its visible

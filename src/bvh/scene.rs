@@ -72,7 +72,13 @@ impl Instance {
         for row in &mut m {
             row[3] = -((row[0] * a(0, 3) + row[1] * a(1, 3)) + row[2] * a(2, 3));
         }
-        let to_object = m.map(|row| row.map(|x| x as f32));
+        // (Loops, not `map`: a closure may be left out of line.)
+        let mut to_object = [[0.0f32; 4]; 3];
+        for (out, row) in to_object.iter_mut().zip(&m) {
+            for (y, &x) in out.iter_mut().zip(row) {
+                *y = x as f32;
+            }
+        }
         // Residual of the rounded inverse: A·M − I.
         let mut ok = det.is_finite() && det != 0.0;
         let mo = |r: usize, c: usize| f64::from(to_object[r][c]);
