@@ -837,4 +837,96 @@ mod tests {
             }
         }
     }
+
+    /// Boxes as primitives (empty boxes included).
+    #[cfg(feature = "std")]
+    struct Boxes(std::vec::Vec<Box3>);
+
+    #[cfg(feature = "std")]
+    impl Primitives for Boxes {
+        type Leaf = crate::bvh::Inst4;
+        fn count(&self) -> usize {
+            self.0.len()
+        }
+        fn bounds(&self, i: u32) -> Box3 {
+            self.0[i as usize]
+        }
+        fn put(&self, i: u32, leaf: &mut Self::Leaf, k: usize) {
+            leaf.put(k, i, self.bounds(i));
+        }
+    }
+
+    /// Every primitive exactly once as a child (`LEAF | i`) with its own box, every inner
+    /// child's box the union of its children's; within `n` nodes.
+    #[cfg(feature = "std")]
+    fn check_direct(nodes: &[Node], prims: &Boxes) {
+        let mut seen = std::vec![0u32; prims.0.len()];
+        for (i, n) in nodes.iter().enumerate() {
+            for k in 0..WIDTH {
+                let c = n.child[k];
+                let lo = [n.bounds[0][k], n.bounds[1][k], n.bounds[2][k]];
+                let hi = [n.bounds[3][k], n.bounds[4][k], n.bounds[5][k]];
+                if c == EMPTY {
+                } else if c & LEAF != 0 {
+                    seen[(c & !LEAF) as usize] += 1;
+                    assert_eq!((lo, hi), prims.bounds(c & !LEAF));
+                } else {
+                    assert!(c as usize > i);
+                    let mut b = EMPTY_BOX;
+                    let child = &nodes[c as usize];
+                    for j in (0..WIDTH).filter(|&j| child.child[j] != EMPTY) {
+                        let l = [child.bounds[0][j], child.bounds[1][j], child.bounds[2][j]];
+                        let h = [child.bounds[3][j], child.bounds[4][j], child.bounds[5][j]];
+                        grow(&mut b, &l, &h);
+                    }
+                    assert_eq!((lo, hi), b);
+                }
+            }
+        }
+        assert!(seen.iter().all(|&k| k == 1), "{seen:?}");
+        assert!(nodes.len() <= prims.0.len().max(1));
+    }
+
+    /// One primitive per leaf (an owned scene's top level): every primitive a child of its
+    /// node by its own index, and `refit_direct` after the boxes move.
+    #[cfg(feature = "std")]
+    #[test]
+    fn direct_trees_hold_every_primitive_once() {
+        let mut x = 12345u32;
+        let mut r = move || {
+            x = x.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (x >> 8) as f32 / (1u32 << 24) as f32
+        };
+        for n in [0usize, 1, 2, 7, 8, 9, 17, 100, 1000] {
+            let mut boxes: std::vec::Vec<Box3> = (0..n)
+                .map(|i| {
+                    if i % 13 == 5 {
+                        return EMPTY_BOX; // a free slot
+                    }
+                    let lo = [r() * 100.0, r() * 100.0, r() * 10.0];
+                    let s = [r() * 5.0, r() * 5.0, r() * 5.0];
+                    (lo, [lo[0] + s[0], lo[1] + s[1], lo[2] + s[2]])
+                })
+                .collect();
+            let mut nodes = std::vec![Node::EMPTY; n.max(1)];
+            let mut scratch = std::vec![Scratch::default(); n];
+            let prims = Boxes(boxes.clone());
+            let (used, leaves) =
+                topology(&prims, &mut nodes, &mut scratch, WIDTH, 1, true).unwrap();
+            assert_eq!(leaves, n);
+            nodes.truncate(used.max(1));
+            check_direct(&nodes, &prims);
+            for b in boxes.iter_mut().step_by(3) {
+                b.0[0] += 7.0;
+                b.1[0] += 7.0;
+            }
+            let moved = Boxes(boxes);
+            refit_direct(&moved, &mut nodes).unwrap();
+            check_direct(&nodes, &moved);
+            assert_eq!(
+                refit_direct(&Boxes(std::vec::Vec::new()), &mut nodes).is_err(),
+                n > 0
+            );
+        }
+    }
 }
