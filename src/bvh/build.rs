@@ -630,12 +630,13 @@ pub(crate) fn expand(
                 out.bounds[axis][k] = lo[axis];
                 out.bounds[3 + axis][k] = hi[axis];
             }
-            if per_leaf == 1 && b - a == 1 {
-                out.child[k] = LEAF | s[a as usize].index;
-                used_leaves += 1;
-            } else if (b - a) as usize <= per_leaf {
-                mark(&mut s[a as usize], used_leaves as u32, b - a);
-                out.child[k] = LEAF | used_leaves as u32;
+            if (b - a) as usize <= per_leaf {
+                out.child[k] = if per_leaf == 1 {
+                    LEAF | s[a as usize].index // the primitive itself, no leaf to fill
+                } else {
+                    mark(&mut s[a as usize], used_leaves as u32, b - a);
+                    LEAF | used_leaves as u32
+                };
                 used_leaves += 1;
             } else {
                 if used_nodes >= nodes.len() {
