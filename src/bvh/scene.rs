@@ -117,6 +117,7 @@ impl Instance {
     }
 
     /// An object record in world space: point on the world ray, normal `Mᵀ·n` normalised.
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     pub(crate) fn world_record(&self, i: u32, ray: &Ray, h: Hit) -> Hit {
         world_record(&self.to_object, self.mirror, i, ray, h)
     }
@@ -189,6 +190,7 @@ pub(crate) fn object_packet<L: Lane>(m: &[[f32; 4]; 3], rays: &RayPacket<L>) -> 
 /// An object record `h` of instance `i` (world→object map `m`, mirroring when `mirror`) in
 /// world space: point on the world ray, normal `Mᵀ·n` normalised, the face flipped when the
 /// transform mirrors.
+#[cfg_attr(target_arch = "x86_64", inline(always))]
 pub(crate) fn world_record(m: &[[f32; 4]; 3], mirror: bool, i: u32, ray: &Ray, h: Hit) -> Hit {
     let n = h.normal;
     let w = |c: usize| (m[0][c] * n.x + m[1][c] * n.y) + m[2][c] * n.z;
@@ -372,6 +374,8 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         )
     }
 
+    // Inlined into the query's SIMD level (crate::simd), as the scene's single rays are.
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
         &self,
         cull: Cull,
@@ -382,15 +386,23 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         if C::EVERY {
             return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
         }
-        instances_one(&self.top, ray, 0, c, |i, c| {
-            let Some((inst, object)) = self.placed(i) else {
-                return false;
-            };
-            let local = inst.ray_to_object(ray);
-            object.trace_ray_with::<K, C>(cull, &local, set + i, c)
-        })
+        instances_one(
+            &self.top,
+            ray,
+            0,
+            c,
+            #[cfg_attr(target_arch = "x86_64", inline(always))]
+            |i, c| {
+                let Some((inst, object)) = self.placed(i) else {
+                    return false;
+                };
+                let local = inst.ray_to_object(ray);
+                object.trace_ray_with::<K, C>(cull, &local, set + i, c)
+            },
+        )
     }
 
+    #[cfg_attr(target_arch = "x86_64", inline(always))]
     fn records_with<L: Lane>(
         &self,
         cull: Cull,
@@ -459,40 +471,49 @@ pub(crate) fn instances_one<C: Collector<f32>>(
     mut visit: impl FnMut(u32, &mut C) -> bool,
 ) -> bool {
     let mut slab = None;
-    traverse::one(top.nodes, top.reach, ray, start, c, |li, c| {
-        let Some(leaf) = top.leaves.get(li as usize) else {
-            return false;
-        };
-        let slab = slab.get_or_insert_with(|| Slab::new(ray.origin(), ray.dir(), top.reach));
-        let boxes = leaf.bounds.map(f32x4::new);
-        let (mut bits, tn) = slab.test4(&boxes, &leaf.index, ray.t_min(), c.t_max());
-        while bits != 0 {
-            // The nearest entry first; an instance entered beyond a closest hit found since
-            // the test is skipped.
-            let mut k = bits.trailing_zeros() as usize;
-            let mut rest = bits & (bits - 1);
-            while rest != 0 {
-                let j = rest.trailing_zeros() as usize;
-                rest &= rest - 1;
-                if tn[j] < tn[k] {
-                    k = j;
+    traverse::one(
+        top.nodes,
+        top.reach,
+        ray,
+        start,
+        c,
+        #[cfg_attr(target_arch = "x86_64", inline(always))]
+        |li, c| {
+            let Some(leaf) = top.leaves.get(li as usize) else {
+                return false;
+            };
+            let slab = slab.get_or_insert_with(|| Slab::new(ray.origin(), ray.dir(), top.reach));
+            let boxes = leaf.bounds.map(f32x4::new);
+            let (mut bits, tn) = slab.test4(&boxes, &leaf.index, ray.t_min(), c.t_max());
+            while bits != 0 {
+                // The nearest entry first; an instance entered beyond a closest hit found since
+                // the test is skipped.
+                let mut k = bits.trailing_zeros() as usize;
+                let mut rest = bits & (bits - 1);
+                while rest != 0 {
+                    let j = rest.trailing_zeros() as usize;
+                    rest &= rest - 1;
+                    if tn[j] < tn[k] {
+                        k = j;
+                    }
+                }
+                bits &= !(1 << k);
+                if C::SHRINKS && tn[k] > c.t_max() {
+                    continue;
+                }
+                if visit(leaf.index[k], c) {
+                    return true;
                 }
             }
-            bits &= !(1 << k);
-            if C::SHRINKS && tn[k] > c.t_max() {
-                continue;
-            }
-            if visit(leaf.index[k], c) {
-                return true;
-            }
-        }
-        false
-    })
+            false
+        },
+    )
 }
 
 /// The records of a scene's winners `w` (sets `set..set + n`: instance `set[j] − set`), lane
 /// by lane: `record(i, ray, one)` makes lane `j`'s world record from instance `i`, the lane's
 /// world ray and its winner alone (`set` 0).
+#[cfg_attr(target_arch = "x86_64", inline(always))]
 pub(crate) fn instance_records<L: Lane>(
     rays: &RayPacket<L>,
     set: u32,
