@@ -528,7 +528,12 @@ impl Baked<'_> {
                 #[cfg_attr(target_arch = "x86_64", inline(always))]
                 |r_leaf, c| {
                     let (first, count) = Self::leaf(r_leaf);
-                    let pre = pre.get_or_insert_with(|| K::prepare(&r1));
+                    if pre.is_none() {
+                        pre = Some(K::prepare(&r1));
+                    }
+                    let Some(pre) = &pre else {
+                        return false;
+                    };
                     for t in first..first + count {
                         let r = r1.shrink(true, c.t_max());
                         let tri = TrianglePacket::splat(&self.triangle(t));
@@ -565,7 +570,12 @@ impl Baked<'_> {
                 } else {
                     r4
                 };
-                let pre = pre.get_or_insert_with(|| K::prepare(&r4));
+                if pre.is_none() {
+                    pre = Some(K::prepare(&r4));
+                }
+                let Some(pre) = &pre else {
+                    return false;
+                };
                 let Some(h) = K::first(&r, pre, &four, cull) else {
                     return false;
                 };

@@ -604,10 +604,15 @@ impl<P: Leaf, N: Layout> Bvh<'_, P, N> {
                 } else {
                     r4
                 };
-                let (pre, order) = pre.get_or_insert_with(|| {
-                    let pre = K::prepare(&r4);
-                    (pre, K::order(&pre))
-                });
+                // Not `get_or_insert_with`: a call the compiler may leave out of line, which
+                // then runs at the baseline inside a query entered at a wider level.
+                if pre.is_none() {
+                    let p = K::prepare(&r4);
+                    pre = Some((p, K::order(&p)));
+                }
+                let Some((pre, order)) = &pre else {
+                    return false;
+                };
                 let four = leaf.four(*order);
                 if C::EACH {
                     // Every root of the four (a filter may reject an entry root).

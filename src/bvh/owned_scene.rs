@@ -680,9 +680,11 @@ impl OwnedScene {
         )
     }
 
-    /// The one-ray query with kernels `T`, `S` and culling `cull`, inlined (with the query's
-    /// `trace_ray` and the instance closure) into the query's SIMD level ([`crate::simd`]):
-    /// out of line it ran at the baseline, 15–27 % more instructions per ray.
+    /// The one-ray query with kernels `T`, `S` and culling `cull`. The top level's traversal
+    /// is inlined (with the query's `trace_ray`) into the query's SIMD level
+    /// ([`crate::simd`]); the instance closure, with the objects' traversals, is left to the
+    /// compiler (forced inline, it made every object's traversal a copy per level and per
+    /// stack, and the test suite compiled more than twice as long). See docs/design.md.
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     fn trace_ray_with<T: Kernel<Triangle>, S: Kernel<Sphere>, C: Collector<f32>>(
         &self,
@@ -708,21 +710,13 @@ impl OwnedScene {
         set: u32,
         c: &mut C,
     ) -> bool {
-        traverse::one(
-            &self.top.nodes,
-            self.top.reach,
-            ray,
-            start,
-            c,
-            #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |i, c| {
-                let Some((p, object)) = self.placed(i) else {
-                    return false;
-                };
-                let local = || object_ray(&p.to_object, ray);
-                c.sees(set + i, p.mask) && object.trace_ray::<T, S, C>(cull, &local(), set + i, c)
-            },
-        )
+        traverse::one(&self.top.nodes, self.top.reach, ray, start, c, |i, c| {
+            let Some((p, object)) = self.placed(i) else {
+                return false;
+            };
+            let local = || object_ray(&p.to_object, ray);
+            c.sees(set + i, p.mask) && object.trace_ray::<T, S, C>(cull, &local(), set + i, c)
+        })
     }
 
     /// The records of the winners `w` of a query culled by `cull`.

@@ -374,7 +374,7 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         )
     }
 
-    // Inlined into the query's SIMD level (crate::simd), as the scene's single rays are.
+    // The top level inlined into the query's SIMD level (crate::simd), as in `OwnedScene`.
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     fn trace_ray_with<K: Kernel<P::Prim>, C: Collector<f32>>(
         &self,
@@ -386,20 +386,13 @@ impl<P: Leaf, N: Layout> Set for Scene<'_, P, N> {
         if C::EVERY {
             return self.trace_with::<K, f32, C>(cull, &RayPacket::splat(ray), set, c);
         }
-        instances_one(
-            &self.top,
-            ray,
-            0,
-            c,
-            #[cfg_attr(target_arch = "x86_64", inline(always))]
-            |i, c| {
-                let Some((inst, object)) = self.placed(i) else {
-                    return false;
-                };
-                let local = inst.ray_to_object(ray);
-                object.trace_ray_with::<K, C>(cull, &local, set + i, c)
-            },
-        )
+        instances_one(&self.top, ray, 0, c, |i, c| {
+            let Some((inst, object)) = self.placed(i) else {
+                return false;
+            };
+            let local = inst.ray_to_object(ray);
+            object.trace_ray_with::<K, C>(cull, &local, set + i, c)
+        })
     }
 
     #[cfg_attr(target_arch = "x86_64", inline(always))]
@@ -482,8 +475,23 @@ pub(crate) fn instances_one<C: Collector<f32>>(
             let Some(leaf) = top.leaves.get(li as usize) else {
                 return false;
             };
-            let slab = slab.get_or_insert_with(|| Slab::new(ray.origin(), ray.dir(), top.reach));
-            let boxes = leaf.bounds.map(f32x4::new);
+            // Not `get_or_insert_with` nor `array::map`: calls the compiler may leave out of
+            // line, which then run at the baseline inside a query entered at a wider level.
+            if slab.is_none() {
+                slab = Some(Slab::new(ray.origin(), ray.dir(), top.reach));
+            }
+            let Some(slab) = &slab else {
+                return false;
+            };
+            let b = &leaf.bounds;
+            let boxes = [
+                f32x4::new(b[0]),
+                f32x4::new(b[1]),
+                f32x4::new(b[2]),
+                f32x4::new(b[3]),
+                f32x4::new(b[4]),
+                f32x4::new(b[5]),
+            ];
             let (mut bits, tn) = slab.test4(&boxes, &leaf.index, ray.t_min(), c.t_max());
             while bits != 0 {
                 // The nearest entry first; an instance entered beyond a closest hit found since
