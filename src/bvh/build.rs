@@ -745,7 +745,8 @@ pub(crate) fn refit<'s, P: Primitives + ?Sized>(
 /// [`refit`] for a tree whose leaves are its primitives (built with one primitive per leaf,
 /// see [`topology`]): every box recomputed from `prims`, children before parents; returns the
 /// root's reach. [`BuildError::Mismatch`] for an empty `nodes`, a primitive index past
-/// `prims` or a child index out of range.
+/// `prims` or a child index out of range. (Its one caller, the owned scene, needs `alloc`.)
+#[cfg(feature = "alloc")]
 pub(crate) fn refit_direct<P: Primitives + ?Sized>(
     prims: &P,
     nodes: &mut [Node],
