@@ -86,6 +86,23 @@ pub(crate) fn one<N: Layout, C: Collector<f32>>(
     ray: &Ray,
     start: u32,
     c: &mut C,
+    leaf: impl FnMut(u32, &mut C) -> bool,
+) -> bool {
+    one_fetching(nodes, reach, ray, start, c, None::<&fn(u32)>, leaf)
+}
+
+/// [`one`], with `fetch(r)` called on the reference `r` of every child a node's test lets
+/// through, as soon as the test is made (before the nearest is entered): a caller whose
+/// children are far in memory prefetches them there, so that their misses overlap (the owned
+/// scene's top level). `None`: nothing more than [`one`].
+#[inline(always)]
+pub(crate) fn one_fetching<N: Layout, C: Collector<f32>>(
+    nodes: &[N],
+    reach: f32,
+    ray: &Ray,
+    start: u32,
+    c: &mut C,
+    fetch: Option<&impl Fn(u32)>,
     mut leaf: impl FnMut(u32, &mut C) -> bool,
 ) -> bool {
     if start & LEAF != 0 {
@@ -93,11 +110,12 @@ pub(crate) fn one<N: Layout, C: Collector<f32>>(
     }
     if !C::EVERY
         && size_of::<N::Short>() < size_of::<N::Full>()
-        && let Some(stop) = one_with::<N::Short, N, C>(nodes, reach, ray, start, c, &mut leaf)
+        && let Some(stop) =
+            one_with::<N::Short, N, C>(nodes, reach, ray, start, c, fetch, &mut leaf)
     {
         return stop;
     }
-    one_with::<N::Full, N, C>(nodes, reach, ray, start, c, &mut leaf).unwrap_or(false)
+    one_with::<N::Full, N, C>(nodes, reach, ray, start, c, fetch, &mut leaf).unwrap_or(false)
 }
 
 /// [`one`] from the inner node `start` with the stack `S`: `None` when it overflowed (never
@@ -109,6 +127,7 @@ fn one_with<S: Entries, N: Layout, C: Collector<f32>>(
     ray: &Ray,
     start: u32,
     c: &mut C,
+    fetch: Option<&impl Fn(u32)>,
     leaf: &mut impl FnMut(u32, &mut C) -> bool,
 ) -> Option<bool> {
     if !ray.is_valid() {
@@ -124,6 +143,7 @@ fn one_with<S: Entries, N: Layout, C: Collector<f32>>(
     if bits == 0 {
         return Some(false);
     }
+    fetch_children(first, bits, fetch);
     let mut stack = S::new();
     // The nearest child entered is visited next, without a push (Embree's order).
     let Some((mut r, _)) = push_sorted(&mut stack, first, bits, &tn, |k| tn[k].to_bits()) else {
@@ -133,6 +153,7 @@ fn one_with<S: Entries, N: Layout, C: Collector<f32>>(
         if r & LEAF == 0 {
             if let Some(n) = nodes.get(r as usize) {
                 let (bits, tn) = n.test_one(&slab, ray.t_min(), c.t_max());
+                fetch_children(n, bits, fetch);
                 if let Some((near, _)) = push_sorted(&mut stack, n, bits, &tn, |k| tn[k].to_bits())
                 {
                     r = near;
@@ -149,6 +170,18 @@ fn one_with<S: Entries, N: Layout, C: Collector<f32>>(
                 None => return (!stack.overflowed()).then_some(false),
             }
         };
+    }
+}
+
+/// `fetch(r)` for the references `r` of the children of `n` in `bits`.
+#[inline(always)]
+fn fetch_children<N: Layout>(n: &N, mut bits: u32, fetch: Option<&impl Fn(u32)>) {
+    let Some(fetch) = fetch else {
+        return;
+    };
+    while bits != 0 {
+        fetch(n.child(bits.trailing_zeros() as usize));
+        bits &= bits - 1;
     }
 }
 
