@@ -682,9 +682,10 @@ impl OwnedScene {
 
     /// The one-ray query with kernels `T`, `S` and culling `cull`. The top level's traversal
     /// is inlined (with the query's `trace_ray`) into the query's SIMD level
-    /// ([`crate::simd`]); the instance closure, with the objects' traversals, is left to the
-    /// compiler (forced inline, it made every object's traversal a copy per level and per
-    /// stack, and the test suite compiled more than twice as long). See docs/design.md.
+    /// ([`crate::simd`]); the instance closure is left to the compiler (forced inline, it made
+    /// every object's traversal a copy per level and per stack, and the test suite compiled
+    /// more than twice as long), and enters the level again for the object's traversal. See
+    /// docs/design.md.
     #[cfg_attr(target_arch = "x86_64", inline(always))]
     fn trace_ray_with<T: Kernel<Triangle>, S: Kernel<Sphere>, C: Collector<f32>>(
         &self,
@@ -734,7 +735,14 @@ impl OwnedScene {
                     return false;
                 };
                 let local = || object_ray(&p.to_object, ray);
-                c.sees(set + i, p.mask) && object.trace_ray::<T, S, C>(cull, &local(), set + i, c)
+                // The object's traversal enters the query's level again: the closure is left
+                // out of line (inlined, it is copied into every stack of every level), where
+                // it would run at the baseline.
+                c.sees(set + i, p.mask)
+                    && crate::simd::run(
+                        #[inline(always)]
+                        || object.trace_ray::<T, S, C>(cull, &local(), set + i, c),
+                    )
             },
         )
     }
