@@ -843,9 +843,15 @@ impl<'c, L: Lane, C: Collector<L>, F: Filter> Screen<'c, L, C, F> {
         }
     }
 
-    /// The lanes of `m` whose candidates in `h` (from `at`) the filter keeps.
+    /// [`keep_lanes`](Self::keep_lanes) out of line: one copy per packet type.
     #[inline(never)]
-    fn keep(&self, h: &LaneHit<L>, at: At, mut m: L::Mask) -> L::Mask {
+    fn keep(&self, h: &LaneHit<L>, at: At, m: L::Mask) -> L::Mask {
+        self.keep_lanes(h, at, m)
+    }
+
+    /// The lanes of `m` whose candidates in `h` (from `at`) the filter keeps.
+    #[inline(always)]
+    fn keep_lanes(&self, h: &LaneHit<L>, at: At, mut m: L::Mask) -> L::Mask {
         let u = plus_zero(h.u / h.w);
         let v = plus_zero(h.v / h.w);
         let mut bits = m.bits();
@@ -907,8 +913,14 @@ impl<L: Lane, C: Collector<L>, F: Filter> Collector<L> for Screen<'_, L, C, F> {
         if !F::NONE {
             // Beyond the relaxed upper end nothing can count: the filter is not asked.
             m = m & h.t.lt(self.inner.t_max());
+            // One ray's candidate is asked in line (in the query's SIMD level, crate::simd);
+            // a packet's lanes in one copy out of line.
             if m.any() {
-                m = self.keep(h, at, m);
+                m = if L::LANES == 1 {
+                    self.keep_lanes(h, at, m)
+                } else {
+                    self.keep(h, at, m)
+                };
             }
         }
         if m.none() {

@@ -606,17 +606,27 @@ impl<P: Leaf, N: Layout> Bvh<'_, P, N> {
                 };
                 // Not `get_or_insert_with`: a call the compiler may leave out of line, which
                 // then runs at the baseline inside a query entered at a wider level.
-                if pre.is_none() {
-                    let p = K::prepare(&r4);
-                    pre = Some((p, K::order(&p)));
-                }
-                let Some((pre, order)) = &pre else {
-                    return false;
+                let (pre, order) = match pre {
+                    Some(made) => made,
+                    None => {
+                        let p = K::prepare(&r4);
+                        let made = (p, K::order(&p));
+                        pre = Some(made);
+                        made
+                    }
                 };
-                let four = leaf.four(*order);
+                let pre = &pre;
+                let four = leaf.four(order);
                 if C::EACH {
                     // Every root of the four (a filter may reject an entry root).
-                    return K::each_one(&r, pre, &four, cull, |h| offer_four(h, leaf, li, set, c));
+                    return K::each_one(
+                        &r,
+                        pre,
+                        &four,
+                        cull,
+                        #[inline(always)]
+                        |h| offer_four(h, leaf, li, set, c),
+                    );
                 }
                 let Some(h) = K::first_one(&r, pre, &four, cull) else {
                     return false;
