@@ -218,7 +218,8 @@ pub fn run<R>(f: impl FnOnce() -> R) -> R {
 
 /// Asks the CPU to bring `x` (every cache line it spans) into its caches, without waiting
 /// for it: x86-64's `prefetcht0`; nothing on other targets. It reads nothing and changes no
-/// answer.
+/// answer. (Its one caller is the owned scene's, hence `alloc`.)
+#[cfg(feature = "alloc")]
 #[inline(always)]
 pub(crate) fn prefetch<T>(x: &T) {
     #[cfg(target_arch = "x86_64")]
